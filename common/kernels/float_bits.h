@@ -1,0 +1,42 @@
+// Exact power-of-two scaling.  Multiplying by 2^k is exact in IEEE arithmetic (barring overflow and
+// denormals), so scaling inputs into [1, 2) keeps the products of the triangle test far from both
+// overflow (1e20 coordinates) and underflow (1e-20 coordinates) without changing any decision.
+#ifndef LS_FLOAT_BITS_H
+#define LS_FLOAT_BITS_H
+
+#include "glsl_compat.h"
+
+#ifdef __cplusplus
+namespace lsk {
+#endif
+
+LS_FN float ls_infinity() { return uintBitsToFloat(0x7F800000u); }
+
+// Unbiased binary exponent of a finite, non-zero x (denormals report -127).
+LS_FN int float_exponent(float x) { return ((floatBitsToInt(x) >> 23) & 255) - 127; }
+
+// The k that brings max(|x|) into [1, 2): x * 2^k.  0 for x == 0.
+LS_FN int unit_exponent(float m) {
+  if (m == 0.0f) return 0;
+  return clamp(-float_exponent(m), -126, 126);
+}
+
+// x * 2^e, saturating to +-inf above the float range and flushing to 0 below it (GLSL leaves ldexp
+// undefined there); exact otherwise.
+LS_FN float scale_pow2(float x, int e) {
+  if (x == 0.0f || isinf(x) || isnan(x)) return x;
+  int ex = float_exponent(x);
+  if (ex + e > 127) return x < 0.0f ? -ls_infinity() : ls_infinity();
+  if (ex + e < -126) return 0.0f * x;
+  return ldexp(x, e);
+}
+
+LS_FN vec3 scale_pow2(IN(vec3) v, int e) { return vec3(scale_pow2(v.x, e), scale_pow2(v.y, e), scale_pow2(v.z, e)); }
+
+LS_FN float max_abs(IN(vec3) v) { return max(max(abs(v.x), abs(v.y)), abs(v.z)); }
+
+#ifdef __cplusplus
+}  // namespace lsk
+#endif
+
+#endif

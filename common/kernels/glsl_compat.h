@@ -1,0 +1,67 @@
+// The prelude that lets one source be both GLSL 4.50 and C++20 (DESIGN §4, TOOLCHAIN.md).
+//
+// Rules for every file in common/kernels/:
+//  - float literals carry the `f` suffix; unsigned literals the `u` suffix;
+//  - no constructors, brace initialisation, references, pointers, recursion or templates;
+//  - parameters are written IN(T) x, OUT(T) x, INOUT(T) x; never pass one variable as both an
+//    IN and an OUT argument (GLSL copies, C++ aliases);
+//  - arithmetic whose rounding decides a result is marked `precise` (GLSL NoContraction; on the C++
+//    side -ffp-contract=off does the same job for the whole program);
+//  - every function starts with LS_FN (C++ `inline`, so headers can be included by many files);
+//  - `#ifndef` guards, not `#pragma once`.
+// Functions that read the scene's buffers live in files meant to be included inside a C++ struct that
+// holds the buffers as pointers (see cpu/kernel_context.h), so `nodes[i]` reads the same in both.
+#ifndef LS_GLSL_COMPAT_H
+#define LS_GLSL_COMPAT_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+namespace lsk {
+using uint = std::uint32_t;
+using glm::ivec3;
+using glm::mat3;
+using glm::mat4;
+using glm::uvec2;
+using glm::uvec3;
+using glm::uvec4;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+
+using glm::abs;
+using glm::clamp;
+using glm::cross;
+using glm::dot;
+using glm::floatBitsToInt;
+using glm::floatBitsToUint;
+using glm::intBitsToFloat;
+using glm::isinf;
+using glm::isnan;
+using glm::ldexp;
+using glm::uintBitsToFloat;
+using glm::length;
+using glm::max;
+using glm::min;
+using glm::normalize;
+using glm::sqrt;
+inline float inversesqrt(float x) { return 1.0f / std::sqrt(x); }
+}  // namespace lsk
+
+#define IN(T) const T&
+#define OUT(T) T&
+#define INOUT(T) T&
+#define precise
+#define LS_CONST static constexpr
+#define LS_FN inline
+#else
+#define IN(T) in T
+#define OUT(T) out T
+#define INOUT(T) inout T
+#define LS_CONST const
+#define LS_FN
+#endif
+
+#endif

@@ -1,0 +1,67 @@
+// std430 structures shared by host and shaders, declared once (DESIGN §4).  Each has the same size
+// and member offsets in C++ (glm::vec3 = 12 bytes, 4-aligned) and in GLSL std430 (vec3 16-aligned):
+// a vec3 is always followed by a 4-byte scalar so both layouts agree; cpu/layouts_check.cpp asserts it.
+#ifndef LS_LAYOUTS_H
+#define LS_LAYOUTS_H
+
+#include "glsl_compat.h"
+
+#ifdef __cplusplus
+namespace lsk {
+#endif
+
+// A ray record, identical to the ray file (DESIGN §9): ox oy oz tmin dx dy dz tmax.
+struct Ray {
+  vec3 origin;
+  float tmin;
+  vec3 dir;
+  float tmax;
+};
+
+// A hit record, identical to the hit file: t (+inf on a miss), instance, triangle (0xFFFFFFFF on a
+// miss), u, v (barycentric weights of vertices 1 and 2).
+struct Hit {
+  float t;
+  uint instance;
+  uint triangle;
+  float u;
+  float v;
+};
+
+LS_CONST uint LS_INVALID = 0xFFFFFFFFu;
+
+// A BVH node.  count > 0: a leaf holding primitives [first, first + count).  count == 0: an inner
+// node whose children are the adjacent nodes `first` and `first + 1`.  Indices are absolute in the
+// array the node lives in.  Every node's primitives are one contiguous range (the builder reorders
+// them), so a subtree's triangles are [range_first, range_first + range_count) — used by the LS.
+struct BvhNode {
+  vec3 lo;
+  uint first;
+  vec3 hi;
+  uint count;
+};
+
+// A triangle in the space of its BVH (object space for 2L-*, world space for F-*); w is unused (0).
+struct Triangle {
+  vec4 v0;
+  vec4 v1;
+  vec4 v2;
+};
+
+// One placed object of a two-level structure: the affine world-to-object transform (three rows),
+// where its object's BVH starts, and its instance id.
+struct InstanceRecord {
+  vec4 world_to_object0;
+  vec4 world_to_object1;
+  vec4 world_to_object2;
+  uint root;        // index of the object's root node in the nodes array
+  uint instance;    // instance id (DESIGN §9)
+  uint object;      // index of the unique mesh
+  uint pad;
+};
+
+#ifdef __cplusplus
+}  // namespace lsk
+#endif
+
+#endif

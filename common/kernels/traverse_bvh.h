@@ -1,0 +1,166 @@
+// Exact closest-hit and any-hit traversal of the flat and two-level BVHs.
+//
+// A *context* file: it includes nothing and opens no namespace, because it is included where the
+// scene's buffers are in scope — in a shader after the buffer declarations, in C++ inside the struct
+// lsk::TraceContext (cpu/trace_context.h) whose pointer members carry the same names:
+//   nodes[]          BvhNode   every object BVH (2L) or the one flat BVH (F), children adjacent
+//   tris[]           Triangle  in BVH order
+//   tri_ids[]        uint      triangle id within its mesh, per triangle in BVH order
+//   tri_instances[]  uint      instance id per triangle (flat structures only)
+//   top_nodes[]      BvhNode   the top-level BVH over instances (2L only); leaves index instances[]
+//   instances[]      InstanceRecord, in top-level BVH order (2L only)
+// Ties at equal t go to the lower (instance, triangle), so the answer does not depend on the order in
+// which the structure visits triangles.
+
+LS_CONST int LS_STACK_SIZE = 64;  // the builder caps BVH depth below this
+
+// Offers a triangle hit to the running result; true when it became the result.
+LS_FN bool offer_hit(float t, float u, float v, uint instance, uint triangle, INOUT(Hit) hit) {
+  // ray_triangle never returns t > hit.t, so "not closer" means "equal": then the lower id wins.
+  if (t < hit.t || instance < hit.instance || (instance == hit.instance && triangle < hit.triangle)) {
+    hit.t = t;
+    hit.u = u;
+    hit.v = v;
+    hit.instance = instance;
+    hit.triangle = triangle;
+    return true;
+  }
+  return false;
+}
+
+// Traverses the BVH rooted at nodes[root] with a ray given in that BVH's space.  instance is the id
+// to report, or LS_INVALID to read it per triangle (flat structures).  Returns true when any_hit is
+// set and a hit was found (the caller stops).
+LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint instance, bool any_hit, INOUT(Hit) hit) {
+  TriRay tri_ray = make_tri_ray(origin, dir);
+  vec3 inv_dir = safe_reciprocal(dir);
+  uint stack_node[LS_STACK_SIZE];
+  float stack_t[LS_STACK_SIZE];
+  int sp = 0;
+  float t_root;
+  if (!ray_box(origin, inv_dir, tmin, hit.t, nodes[root].lo, nodes[root].hi, t_root)) return false;
+  uint current = root;
+  while (true) {
+    BvhNode node = nodes[current];
+    if (node.count > 0u) {
+      for (uint i = node.first; i < node.first + node.count; ++i) {
+        Triangle tri = tris[i];
+        float t;
+        float u;
+        float v;
+        if (ray_triangle(tri_ray, tmin, hit.t, vec3(tri.v0), vec3(tri.v1), vec3(tri.v2), t, u, v)) {
+          uint inst = instance == LS_INVALID ? tri_instances[i] : instance;
+          if (offer_hit(t, u, v, inst, tri_ids[i], hit) && any_hit) return true;
+        }
+      }
+    } else {
+      uint left = node.first;
+      uint right = node.first + 1u;
+      float t_left;
+      float t_right;
+      bool hit_left = ray_box(origin, inv_dir, tmin, hit.t, nodes[left].lo, nodes[left].hi, t_left);
+      bool hit_right = ray_box(origin, inv_dir, tmin, hit.t, nodes[right].lo, nodes[right].hi, t_right);
+      if (hit_left && hit_right) {
+        bool left_first = t_left <= t_right;
+        stack_node[sp] = left_first ? right : left;
+        stack_t[sp] = left_first ? t_right : t_left;
+        sp = sp + 1;
+        current = left_first ? left : right;
+        continue;
+      }
+      if (hit_left || hit_right) {
+        current = hit_left ? left : right;
+        continue;
+      }
+    }
+    // Pop the nearest pending node that can still hold something closer than the current hit.
+    bool found = false;
+    while (sp > 0 && !found) {
+      sp = sp - 1;
+      if (stack_t[sp] <= widen_distance(hit.t)) {
+        current = stack_node[sp];
+        found = true;
+      }
+    }
+    if (!found) break;
+  }
+  return false;
+}
+
+LS_FN Hit empty_hit(IN(Ray) ray) {
+  Hit hit;
+  hit.t = ray.tmax;
+  hit.instance = LS_INVALID;
+  hit.triangle = LS_INVALID;
+  hit.u = 0.0f;
+  hit.v = 0.0f;
+  return hit;
+}
+
+// A miss reports t = +inf (DESIGN §9).
+LS_FN Hit finish_hit(IN(Hit) hit) {
+  Hit h = hit;
+  if (h.triangle == LS_INVALID) h.t = ls_infinity();
+  return h;
+}
+
+LS_FN Hit trace_flat(IN(Ray) ray, bool any_hit) {
+  Hit hit = empty_hit(ray);
+  trace_bvh(0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, any_hit, hit);
+  return finish_hit(hit);
+}
+
+// The ray is carried into each instance's object space; an affine map keeps t unchanged.
+LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
+  Hit hit = empty_hit(ray);
+  vec3 inv_dir = safe_reciprocal(ray.dir);
+  uint stack_node[LS_STACK_SIZE];
+  float stack_t[LS_STACK_SIZE];
+  int sp = 0;
+  float t_root;
+  bool pending = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[0].lo, top_nodes[0].hi, t_root);
+  uint current = 0u;
+  while (pending) {
+    BvhNode node = top_nodes[current];
+    if (node.count > 0u) {
+      for (uint i = node.first; i < node.first + node.count; ++i) {
+        InstanceRecord rec = instances[i];
+        precise vec3 o = vec3(dot(rec.world_to_object0, vec4(ray.origin, 1.0f)),
+                              dot(rec.world_to_object1, vec4(ray.origin, 1.0f)),
+                              dot(rec.world_to_object2, vec4(ray.origin, 1.0f)));
+        precise vec3 d = vec3(dot(rec.world_to_object0, vec4(ray.dir, 0.0f)),
+                              dot(rec.world_to_object1, vec4(ray.dir, 0.0f)),
+                              dot(rec.world_to_object2, vec4(ray.dir, 0.0f)));
+        if (trace_bvh(rec.root, o, d, ray.tmin, rec.instance, any_hit, hit)) return finish_hit(hit);
+      }
+    } else {
+      uint left = node.first;
+      uint right = node.first + 1u;
+      float t_left;
+      float t_right;
+      bool hit_left = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[left].lo, top_nodes[left].hi, t_left);
+      bool hit_right = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[right].lo, top_nodes[right].hi, t_right);
+      if (hit_left && hit_right) {
+        bool left_first = t_left <= t_right;
+        stack_node[sp] = left_first ? right : left;
+        stack_t[sp] = left_first ? t_right : t_left;
+        sp = sp + 1;
+        current = left_first ? left : right;
+        continue;
+      }
+      if (hit_left || hit_right) {
+        current = hit_left ? left : right;
+        continue;
+      }
+    }
+    pending = false;
+    while (sp > 0 && !pending) {
+      sp = sp - 1;
+      if (stack_t[sp] <= widen_distance(hit.t)) {
+        current = stack_node[sp];
+        pending = true;
+      }
+    }
+  }
+  return finish_hit(hit);
+}

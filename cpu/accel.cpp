@@ -1,0 +1,181 @@
+#include "accel.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+
+namespace ls {
+namespace {
+
+Bounds triangle_bounds(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  Bounds box;
+  box.grow(a);
+  box.grow(b);
+  box.grow(c);
+  return box;
+}
+
+lsk::Triangle make_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  lsk::Triangle t;
+  t.v0 = glm::vec4(a, 0.0f);
+  t.v1 = glm::vec4(b, 0.0f);
+  t.v2 = glm::vec4(c, 0.0f);
+  return t;
+}
+
+Bounds transformed_bounds(const glm::mat4& m, const glm::vec3& lo, const glm::vec3& hi) {
+  Bounds box;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
+    box.grow(transform_point(m, p));
+  }
+  return box;
+}
+
+void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel) {
+  // World-space triangles, instance by instance in id order.
+  std::vector<size_t> first(scene.instances.size() + 1, 0);
+  for (size_t i = 0; i < scene.instances.size(); ++i)
+    first[i + 1] = first[i] + scene.meshes[scene.instances[i].mesh].triangles.size();
+  const size_t total = first.back();
+  std::vector<lsk::Triangle> world(total);
+  std::vector<Bounds> boxes(total);
+  tbb::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
+    const Instance& inst = scene.instances[i];
+    const Mesh& mesh = scene.meshes[inst.mesh];
+    tbb::parallel_for(size_t(0), mesh.triangles.size(), [&](size_t t) {
+      const glm::uvec3 idx = mesh.triangles[t];
+      const glm::vec3 a = transform_point(inst.object_to_world, mesh.positions[idx.x]);
+      const glm::vec3 b = transform_point(inst.object_to_world, mesh.positions[idx.y]);
+      const glm::vec3 c = transform_point(inst.object_to_world, mesh.positions[idx.z]);
+      world[first[i] + t] = make_triangle(a, b, c);
+      boxes[first[i] + t] = triangle_bounds(a, b, c);
+    });
+  });
+  BvhBuildResult bvh = build_bvh(boxes, options);
+  accel.nodes = std::move(bvh.nodes);
+  accel.max_depth = bvh.max_depth;
+  accel.tris.resize(total);
+  accel.tri_ids.resize(total);
+  accel.tri_instances.resize(total);
+  tbb::parallel_for(size_t(0), total, [&](size_t k) {
+    const size_t src = bvh.order[k];
+    const size_t inst = size_t(std::upper_bound(first.begin(), first.end(), src) - first.begin()) - 1;
+    accel.tris[k] = world[src];
+    accel.tri_ids[k] = uint32_t(src - first[inst]);
+    accel.tri_instances[k] = uint32_t(inst);
+  });
+  std::vector<bool> used(scene.meshes.size(), false);
+  for (const Instance& inst : scene.instances) used[inst.mesh] = true;
+  accel.objects = size_t(std::count(used.begin(), used.end(), true));
+}
+
+void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& accel) {
+  std::vector<bool> used(scene.meshes.size(), false);
+  for (const Instance& inst : scene.instances) used[inst.mesh] = true;
+
+  // One BVH per unique mesh, in object space, built in parallel.
+  std::vector<BvhBuildResult> object_bvh(scene.meshes.size());
+  tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
+    const Mesh& mesh = scene.meshes[m];
+    if (!used[m] || mesh.triangles.empty()) return;
+    std::vector<Bounds> boxes(mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3 idx = mesh.triangles[t];
+      boxes[t] = triangle_bounds(mesh.positions[idx.x], mesh.positions[idx.y], mesh.positions[idx.z]);
+    }
+    object_bvh[m] = build_bvh(boxes, options);
+  });
+
+  // Concatenate: node and triangle indices become absolute.
+  accel.object_roots.assign(scene.meshes.size(), lsk::LS_INVALID);
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (object_bvh[m].nodes.empty()) continue;
+    const Mesh& mesh = scene.meshes[m];
+    const uint32_t node_base = uint32_t(accel.nodes.size());
+    const uint32_t tri_base = uint32_t(accel.tris.size());
+    accel.object_roots[m] = node_base;
+    for (lsk::BvhNode node : object_bvh[m].nodes) {
+      node.first += node.count > 0 ? tri_base : node_base;
+      accel.nodes.push_back(node);
+    }
+    for (uint32_t src : object_bvh[m].order) {
+      const glm::uvec3 idx = mesh.triangles[src];
+      accel.tris.push_back(make_triangle(mesh.positions[idx.x], mesh.positions[idx.y], mesh.positions[idx.z]));
+      accel.tri_ids.push_back(src);
+    }
+    accel.max_depth = std::max(accel.max_depth, object_bvh[m].max_depth);
+    ++accel.objects;
+  }
+
+  // The top level over instance boxes (each object's root box carried into the world).
+  std::vector<Bounds> boxes;
+  for (const Instance& inst : scene.instances) {
+    const lsk::BvhNode& root = accel.nodes[accel.object_roots[inst.mesh]];
+    boxes.push_back(transformed_bounds(inst.object_to_world, root.lo, root.hi));
+  }
+  BvhBuildResult top = build_bvh(boxes, options);
+  accel.top_nodes = std::move(top.nodes);
+  for (uint32_t id : top.order) {
+    const Instance& inst = scene.instances[id];
+    const glm::mat4 w2o = glm::mat4(glm::inverse(glm::dmat4(inst.object_to_world)));
+    lsk::InstanceRecord rec;
+    rec.world_to_object0 = glm::vec4(w2o[0][0], w2o[1][0], w2o[2][0], w2o[3][0]);
+    rec.world_to_object1 = glm::vec4(w2o[0][1], w2o[1][1], w2o[2][1], w2o[3][1]);
+    rec.world_to_object2 = glm::vec4(w2o[0][2], w2o[1][2], w2o[2][2], w2o[3][2]);
+    rec.root = accel.object_roots[inst.mesh];
+    rec.instance = id;
+    rec.object = inst.mesh;
+    rec.pad = 0;
+    accel.instances.push_back(rec);
+  }
+}
+
+}  // namespace
+
+size_t Accel::bytes_total() const {
+  return nodes.size() * sizeof(lsk::BvhNode) + tris.size() * sizeof(lsk::Triangle) +
+         tri_ids.size() * sizeof(uint32_t) + tri_instances.size() * sizeof(uint32_t) +
+         top_nodes.size() * sizeof(lsk::BvhNode) + instances.size() * sizeof(lsk::InstanceRecord) + bytes_ls();
+}
+
+lsk::TraceContext Accel::context() const {
+  lsk::TraceContext c;
+  c.nodes = nodes.data();
+  c.tris = tris.data();
+  c.tri_ids = tri_ids.data();
+  c.tri_instances = tri_instances.data();
+  c.top_nodes = top_nodes.data();
+  c.instances = instances.data();
+  return c;
+}
+
+Accel build_accel(const Scene& scene, const StructureSpec& spec, const BvhBuildOptions& options) {
+  if (spec.line_space())
+    throw InputError("structure '" + spec.name() + "': Line Space structures are not implemented yet (use bvh or 2l-bvh)");
+  const auto start = std::chrono::steady_clock::now();
+  Accel accel;
+  accel.spec = spec;
+  accel.instance_count = scene.instances.size();
+  accel.world_triangles = triangle_count(scene);
+  if (spec.two_level())
+    build_two_level(scene, options, accel);
+  else
+    build_flat(scene, options, accel);
+  accel.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return accel;
+}
+
+lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit) {
+  lsk::TraceContext c = context;
+  return accel.spec.two_level() ? c.trace_two_level(ray, any_hit) : c.trace_flat(ray, any_hit);
+}
+
+void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit) {
+  const lsk::TraceContext context = accel.context();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray(context, accel, rays[i], any_hit);
+  });
+}
+
+}  // namespace ls

@@ -1,0 +1,32 @@
+// Scene loading: a path (.gltf .glb .obj .ply .off .stl) or `builtin:NAME`.  Throws ls::InputError
+// with a one-line reason on anything it cannot load; every returned scene has passed validate_scene().
+#pragma once
+
+#include "scene.h"
+
+#include <cstdint>
+#include <string>
+
+namespace ls {
+
+Scene load_scene(const std::string& spec);
+
+// glTF 2.0 (.gltf or .glb): meshes are objects, mesh-bearing nodes of the default scene are instances
+// (ordered by node index), baseColorFactor is the albedo, emissiveFactor makes an area light, the
+// first perspective camera is the view (else a framing camera).
+Scene load_gltf(const std::string& path);
+
+// One OBJ/PLY/OFF/STL mesh through OpenMesh: a one-object scene with a framing camera and a
+// default light (a white background that lights the mesh from every direction).
+Scene load_mesh_file(const std::string& path);
+
+// Built-in, deterministic scenes (no files):
+//   builtin:cornell                  closed room, several objects, one area light (the default scene)
+//   builtin:instances                room with 64 instances of one 51,200-triangle mesh + unique objects
+//   builtin:generated:T:O:S          T triangles spread over O objects, seed S (scaling studies)
+Scene builtin_scene(const std::string& name);
+
+// Applies a uniform scale and then an offset to every instance (numerical-extreme studies).
+void scale_and_offset(Scene& scene, float scale, const glm::vec3& offset);
+
+}  // namespace ls
