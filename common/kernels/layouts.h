@@ -60,6 +60,18 @@ struct InstanceRecord {
   uint pad;
 };
 
+// A pinhole camera: world position, orthonormal frame, tan(vertical fov / 2), image size.
+struct CameraFrame {
+  vec3 position;
+  float tan_half_fov;
+  vec3 right;
+  float aspect;  // width / height
+  vec3 up;
+  uint width;
+  vec3 forward;
+  uint height;
+};
+
 #ifdef __cplusplus
 }  // namespace lsk
 #endif

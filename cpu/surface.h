@@ -1,0 +1,38 @@
+// What a hit means on the surface: world position, normals and material.  The path tracer and the
+// ray generators share it.
+#pragma once
+
+#include "kernels/layouts.h"
+#include "scene.h"
+
+#include <vector>
+
+namespace ls {
+
+struct SurfacePoint {
+  glm::vec3 position;
+  glm::vec3 geometric_normal;  // unit, world space, facing the side the ray came from
+  glm::vec3 shading_normal;    // unit, interpolated vertex normal, on the same side
+  uint32_t material;
+};
+
+// Per-instance transforms prepared once for shading.
+class SurfaceLookup {
+ public:
+  explicit SurfaceLookup(const Scene& scene);
+  // hit must be a hit (triangle != LS_INVALID); ray_dir is the direction of the ray that found it.
+  SurfacePoint at(const lsk::Hit& hit, const glm::vec3& ray_dir) const;
+  // World-space vertices of a triangle.
+  void world_triangle(uint32_t instance, uint32_t triangle, glm::vec3& a, glm::vec3& b, glm::vec3& c) const;
+  // A power of two at least the largest absolute world coordinate (the ray-offset scale).
+  float scene_scale() const { return scene_scale_; }
+
+ private:
+  const Scene& scene_;
+  std::vector<glm::mat3> normal_matrix_;
+  float scene_scale_ = 1.0f;
+};
+
+lsk::CameraFrame camera_frame(const Camera& camera, uint32_t width, uint32_t height);
+
+}  // namespace ls
