@@ -1,0 +1,64 @@
+#include "image_output.h"
+
+#include "scene.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace ls {
+namespace {
+
+void write_pixels(const std::string& path, uint32_t width, uint32_t height, OIIO::TypeDesc type, const void* data) {
+  const std::string temp = path + ".partial" + std::filesystem::path(path).extension().string();
+  auto out = OIIO::ImageOutput::create(temp);
+  if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
+  OIIO::ImageSpec spec(int(width), int(height), 3, type);
+  if (type == OIIO::TypeDesc::FLOAT) spec.attribute("compression", "zip");
+  if (!out->open(temp, spec) || !out->write_image(type, data) || !out->close())
+    throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
+  std::filesystem::rename(temp, path);
+}
+
+float srgb(float linear) {
+  const float x = std::clamp(linear, 0.0f, 1.0f);
+  return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace
+
+void write_exr(const std::string& path, const Image& image) {
+  write_pixels(path, image.width, image.height, OIIO::TypeDesc::FLOAT, image.pixels.data());
+}
+
+void write_png(const std::string& path, const Image& image, float exposure) {
+  std::vector<uint8_t> bytes(image.pixels.size() * 3);
+  for (size_t i = 0; i < image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.pixels[i][c] * exposure;
+      bytes[3 * i + size_t(c)] = uint8_t(std::lround(255.0f * srgb(std::isfinite(v) ? v : 0.0f)));
+    }
+  write_pixels(path, image.width, image.height, OIIO::TypeDesc::UINT8, bytes.data());
+}
+
+Image read_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw InputError("cannot read image '" + path + "': " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.nchannels < 3) throw InputError("image '" + path + "' has fewer than 3 channels");
+  std::vector<float> data(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) throw InputError("cannot read image '" + path + "': " + in->geterror());
+  Image image;
+  image.width = uint32_t(spec.width);
+  image.height = uint32_t(spec.height);
+  image.pixels.resize(size_t(spec.width) * size_t(spec.height));
+  for (size_t i = 0; i < image.pixels.size(); ++i)
+    image.pixels[i] = glm::vec3(data[i * size_t(spec.nchannels)], data[i * size_t(spec.nchannels) + 1],
+                                data[i * size_t(spec.nchannels) + 2]);
+  return image;
+}
+
+}  // namespace ls

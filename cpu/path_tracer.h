@@ -1,0 +1,65 @@
+// The CPU path tracer: Lambertian surfaces, emissive triangles as area lights with next-event
+// estimation and multiple importance sampling (power heuristic), a background radiance for rays that
+// leave the scene, and the acceleration structure chosen per bounce by a schedule.
+//
+// Bounces (DESIGN §3): bounce 0 is the camera ray and the shadow ray from its hit; bounce k >= 1 is
+// the k-th indirect segment and the shadow ray from its hit.  The image of bounce k holds what the
+// rays of bounce k found: emission hit by its segment (MIS-weighted; weight 1 at bounce 0) plus the
+// light its shadow ray let through.  The total image is their sum.
+//
+// It runs as a wavefront, one sample per pixel per pass: all rays of one bounce are traced as one
+// batch on all threads, so the time spent tracing each bounce is measured apart from shading.
+// Random numbers are keyed by (seed, pixel, sample, bounce, dimension): a render whose schedule is
+// exact before bounce k follows exactly the same paths as the all-exact render up to bounce k.
+#pragma once
+
+#include "accel.h"
+#include "scene.h"
+#include "structure_name.h"
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace ls {
+
+struct RenderOptions {
+  Schedule schedule;
+  int spp = 16;
+  int bounces = 3;  // indirect segments after the primary hit
+  uint32_t width = 512;
+  uint32_t height = 512;
+  uint32_t seed = 1;
+};
+
+struct BounceStats {
+  uint64_t extension_rays = 0;  // camera rays at bounce 0
+  uint64_t shadow_rays = 0;
+  double trace_seconds = 0.0;   // wall-clock time spent inside trace batches
+  std::string structure;
+};
+
+struct RenderResult {
+  uint32_t width = 0, height = 0;
+  std::vector<std::vector<glm::vec3>> bounce_images;  // bounces + 1 images, row-major, top row first
+  std::vector<glm::vec3> total;
+  std::vector<BounceStats> bounces;
+  uint64_t dropped_samples = 0;                       // non-finite contributions left out
+  double seconds = 0.0;                               // whole render, shading included
+  uint64_t indirect_rays() const;
+  double indirect_seconds() const;
+  double indirect_mrays_per_s() const;
+};
+
+// progress(done, total) is called after every pass (one sample per pixel).
+using Progress = std::function<void(int done, int total)>;
+
+// structures: built structures keyed by canonical name; every schedule entry must be present.
+RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
+                    const Progress& progress = {});
+
+// Builds each distinct structure of the schedule once.
+std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule);
+
+}  // namespace ls

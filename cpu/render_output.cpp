@@ -1,0 +1,77 @@
+#include "render_output.h"
+
+#include "bench.h"
+#include "image_output.h"
+
+#include <tbb/info.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace ls {
+
+nlohmann::json render_report(const RenderResult& result, const RenderReportContext& context) {
+  using nlohmann::json;
+  json per_bounce = json::array();
+  for (size_t k = 0; k < result.bounces.size(); ++k) {
+    const BounceStats& b = result.bounces[k];
+    const uint64_t rays = b.extension_rays + b.shadow_rays;
+    per_bounce.push_back({{"bounce", k},
+                          {"structure", b.structure},
+                          {"extension_rays", b.extension_rays},
+                          {"shadow_rays", b.shadow_rays},
+                          {"rays", rays},
+                          {"seconds", b.trace_seconds},
+                          {"mrays_per_s", b.trace_seconds > 0.0 ? double(rays) / b.trace_seconds * 1e-6 : 0.0}});
+  }
+  json structures = json::array();
+  if (context.structures)
+    for (const auto& [name, accel] : *context.structures)
+      structures.push_back({{"structure", name},
+                            {"build_seconds", accel.build_seconds},
+                            {"bytes_total", accel.bytes_total()},
+                            {"bytes_ls", accel.bytes_ls()}});
+  const BounceStats& primary = result.bounces.front();
+  return json{{"scene", context.scene},
+              {"schedule", context.schedule},
+              {"width", result.width},
+              {"height", result.height},
+              {"spp", context.spp},
+              {"bounces", int(result.bounces.size()) - 1},
+              {"seed", context.seed},
+              {"device", "cpu: " + cpu_model()},
+              {"threads", tbb::info::default_concurrency()},
+              {"seconds", result.seconds},
+              {"primary", {{"rays", primary.extension_rays + primary.shadow_rays}, {"seconds", primary.trace_seconds}}},
+              {"indirect",
+               {{"rays", result.indirect_rays()},
+                {"seconds", result.indirect_seconds()},
+                {"mrays_per_s", result.indirect_mrays_per_s()}}},
+              {"per_bounce", per_bounce},
+              {"structures", structures},
+              {"dropped_samples", result.dropped_samples}};
+}
+
+nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError("cannot create output folder '" + dir + "': " + ec.message());
+  const std::filesystem::path out(dir);
+  Image image{result.width, result.height, result.total};
+  write_exr((out / "total.exr").string(), image);
+  write_png((out / "image.png").string(), image);
+  for (size_t k = 0; k < result.bounce_images.size(); ++k)
+    write_exr((out / ("bounce_" + std::to_string(k) + ".exr")).string(),
+              Image{result.width, result.height, result.bounce_images[k]});
+  nlohmann::json report = render_report(result, context);
+  const std::string path = (out / "report.json").string();
+  {
+    std::ofstream f(path + ".partial");
+    f << report.dump(2) << "\n";
+    if (!f) throw InputError("cannot write '" + path + "'");
+  }
+  std::filesystem::rename(path + ".partial", path);
+  return report;
+}
+
+}  // namespace ls

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian packages linespace needs (only those missing) and builds it in Release.
+# Used by the README's two commands; safe to run again.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(build-essential cmake ninja-build pkg-config
+  libtbb-dev libxsimd-dev libglm-dev libopenmesh-dev libopenimageio-dev openimageio-tools
+  glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
+  mesa-vulkan-drivers libvulkan-dev vulkan-tools)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "setup: installing ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+cmake --preset release >/dev/null
+cmake --build --preset release
