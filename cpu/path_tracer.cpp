@@ -219,7 +219,9 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
           if (cos_s > 0.0f && cos_l > 0.0f && dist2 > 0.0f) {
             const float light_pdf = lights.area_pdf(l.emission) * dist2 / cos_l;
             const float bsdf_pdf = cos_s / lsk::LS_PI;
-            const float weight = lsk::power_heuristic(light_pdf, bsdf_pdf);
+            // The last bounce traces no further segment to find this light by BSDF sampling, so its
+            // light sample carries the whole weight.
+            const float weight = k == bounces ? 1.0f : lsk::power_heuristic(light_pdf, bsdf_pdf);
             ShadowQuery& sq = shadows[p];
             sq.ray.origin = origin;
             sq.ray.dir = d;

@@ -5,7 +5,9 @@
 // Bounces (DESIGN §3): bounce 0 is the camera ray and the shadow ray from its hit; bounce k >= 1 is
 // the k-th indirect segment and the shadow ray from its hit.  The image of bounce k holds what the
 // rays of bounce k found: emission hit by its segment (MIS-weighted; weight 1 at bounce 0) plus the
-// light its shadow ray let through.  The total image is their sum.
+// light its shadow ray let through.  The total image is their sum.  At the last bounce the light
+// sample takes the full weight, since no further segment could find that light by BSDF sampling:
+// the render is then an unbiased estimate of light paths with at most bounces + 2 segments.
 //
 // It runs as a wavefront, one sample per pixel per pass: all rays of one bounce are traced as one
 // batch on all threads, so the time spent tracing each bounce is measured apart from shading.

@@ -1,0 +1,130 @@
+// linespace-cpu end to end: the file formats, the JSON keys of DESIGN §9, and exit status 2 with a
+// one-line reason on bad input.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+Run run(const std::string& args) {
+  const fs::path dir = fs::temp_directory_path() / "linespace_cli_test";
+  fs::create_directories(dir);
+  const std::string out = (dir / "stdout").string(), err = (dir / "stderr").string();
+  const std::string cmd = std::string(LINESPACE_CPU) + " " + args + " >" + out + " 2>" + err;
+  const int raw = std::system(cmd.c_str());
+  Run r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  auto slurp = [](const std::string& p) {
+    std::ifstream f(p);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+fs::path temp(const std::string& name) { return fs::temp_directory_path() / "linespace_cli_test" / name; }
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream f(p, std::ios::binary);
+  f << text;
+}
+
+size_t line_count(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
+
+}  // namespace
+
+TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
+  fs::create_directories(temp(""));
+  write_text(temp("bad.gltf"), "{ this is not json");
+  write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+  write_text(temp("empty.obj"), "");
+  write_text(temp("odd.rays"), std::string(33, '\0'));
+  const std::array<std::string, 16> cases = {
+      "build --scene /nonexistent/scene.gltf",
+      "build --scene " + temp("bad.gltf").string(),
+      "build --scene " + temp("nan.obj").string(),
+      "build --scene " + temp("empty.obj").string(),
+      "build --scene builtin:nope",
+      "build --scene scene.xyz",
+      "build --structure octree",
+      "build --structure f-ls:8",
+      "render --schedule bvh,,bvh --size 8x8 --out " + temp("r").string(),
+      "render --size 0x10 --out " + temp("r").string(),
+      "render --size banana --out " + temp("r").string(),
+      "render --spp 0 --size 8x8 --out " + temp("r").string(),
+      "trace --rays " + temp("odd.rays").string() + " --hits " + temp("h").string(),
+      "trace --rays /nonexistent.rays --hits " + temp("h").string(),
+      "rays --kind sideways --count 10 --out " + temp("x.rays").string(),
+      "frobnicate",
+  };
+  for (const std::string& args : cases) {
+    const Run r = run(args);
+    INFO(args << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.rfind("linespace-cpu: ", 0) == 0);
+  }
+}
+
+TEST_CASE("rays, trace and build agree with the file formats and JSON keys", "[cli]") {
+  fs::create_directories(temp(""));
+  const std::string rays = temp("d.rays").string(), hits = temp("d.hits").string();
+  Run r = run("rays --scene builtin:cornell --kind diffuse --count 1000 --seed 3 --out " + rays);
+  REQUIRE(r.status == 0);
+  REQUIRE(fs::file_size(rays) == 1000u * 32u);
+  r = run("trace --scene builtin:cornell --structure 2l-bvh --rays " + rays + " --hits " + hits);
+  REQUIRE(r.status == 0);
+  REQUIRE(fs::file_size(hits) == 1000u * 20u);
+  // The cornell room is closed: every diffuse ray hits something, with a finite t and valid ids.
+  std::ifstream f(hits, std::ios::binary);
+  for (int i = 0; i < 1000; ++i) {
+    float t, u, v;
+    uint32_t inst, tri;
+    f.read(reinterpret_cast<char*>(&t), 4).read(reinterpret_cast<char*>(&inst), 4).read(reinterpret_cast<char*>(&tri), 4);
+    f.read(reinterpret_cast<char*>(&u), 4).read(reinterpret_cast<char*>(&v), 4);
+    REQUIRE(std::isfinite(t));
+    REQUIRE(tri != 0xFFFFFFFFu);
+    REQUIRE(u >= 0.0f);
+    REQUIRE(v >= 0.0f);
+    REQUIRE(u + v <= 1.0001f);
+  }
+  r = run("build --scene builtin:cornell --structure 2l-bvh --json");
+  REQUIRE(r.status == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"triangles", "objects", "instances", "nodes", "ls_nodes", "shafts_per_ls", "bytes_total", "bytes_ls",
+                          "build_seconds"})
+    CHECK(j.contains(key));
+  CHECK(j["triangles"].get<int>() > 0);
+}
+
+TEST_CASE("render writes every image and a report", "[cli]") {
+  const fs::path out = temp("render");
+  fs::remove_all(out);
+  const Run r = run("render --scene builtin:cornell --schedule bvh,2l-bvh --spp 1 --bounces 2 --size 16x12 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  for (const char* f : {"total.exr", "bounce_0.exr", "bounce_1.exr", "bounce_2.exr", "image.png", "report.json"})
+    CHECK(fs::exists(out / f));
+  std::ifstream f(out / "report.json");
+  const auto j = nlohmann::json::parse(f);
+  CHECK(j["per_bounce"].size() == 3);
+  CHECK(j["per_bounce"][0]["structure"] == "bvh");
+  CHECK(j["per_bounce"][2]["structure"] == "2l-bvh");
+  CHECK(j["per_bounce"][0]["extension_rays"].get<int>() == 16 * 12);
+  CHECK(j["indirect"]["rays"].get<long>() > 0);
+  CHECK(j.contains("primary"));
+}
