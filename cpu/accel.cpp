@@ -3,6 +3,8 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <cmath>
+#include <mutex>
 
 namespace ls {
 namespace {
@@ -133,6 +135,11 @@ void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& 
 
 }  // namespace
 
+size_t Accel::bytes_ls() const {
+  return node_ls.size() * sizeof(uint32_t) + ls_nodes.size() * sizeof(lsk::LsNode) +
+         ls_candidates.size() * sizeof(uint32_t) + tri_normals.size() * sizeof(glm::uvec4);
+}
+
 size_t Accel::bytes_total() const {
   return nodes.size() * sizeof(lsk::BvhNode) + tris.size() * sizeof(lsk::Triangle) +
          tri_ids.size() * sizeof(uint32_t) + tri_instances.size() * sizeof(uint32_t) +
@@ -147,34 +154,64 @@ lsk::TraceContext Accel::context() const {
   c.tri_instances = tri_instances.data();
   c.top_nodes = top_nodes.data();
   c.instances = instances.data();
+  if (spec.line_space()) {
+    c.node_ls = node_ls.data();
+    c.ls_nodes = ls_nodes.data();
+    c.ls_candidates = ls_candidates.data();
+    c.tri_normals = tri_normals.data();
+    c.ls_enabled = 1;
+    c.ls_n = uint32_t(spec.subdivision);
+    const double a = double(ls_options.angle_degrees) * 3.14159265358979323846 / 180.0;
+    c.ls_cos2 = ls_options.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
+  }
   return c;
 }
 
-Accel build_accel(const Scene& scene, const StructureSpec& spec, const BvhBuildOptions& options) {
-  if (spec.line_space())
-    throw InputError("structure '" + spec.name() + "': Line Space structures are not implemented yet (use bvh or 2l-bvh)");
+Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Accel accel;
   accel.spec = spec;
   accel.instance_count = scene.instances.size();
   accel.world_triangles = triangle_count(scene);
   if (spec.two_level())
-    build_two_level(scene, options, accel);
+    build_two_level(scene, options.bvh, accel);
   else
-    build_flat(scene, options, accel);
+    build_flat(scene, options.bvh, accel);
+  if (spec.line_space()) build_line_space(scene, options.ls, accel);
   accel.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return accel;
 }
 
-lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit) {
-  lsk::TraceContext c = context;
-  return accel.spec.two_level() ? c.trace_two_level(ray, any_hit) : c.trace_flat(ray, any_hit);
+lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit) {
+  return accel.spec.two_level() ? context.trace_two_level(ray, any_hit) : context.trace_flat(ray, any_hit);
 }
 
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit) {
+lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit) {
+  lsk::TraceContext c = context;
+  return trace_ray_counted(c, accel, ray, any_hit);
+}
+
+void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from) {
+  into.lookups += from.lookups;
+  into.empty += from.empty;
+  into.accepted += from.accepted;
+  into.refused_angle += from.refused_angle;
+  into.refused_interval += from.refused_interval;
+  into.refused_parallel += from.refused_parallel;
+  into.refused_no_shaft += from.refused_no_shaft;
+}
+
+void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+                lsk::LsCounters* counters) {
   const lsk::TraceContext context = accel.context();
+  std::mutex mutex;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray(context, accel, rays[i], any_hit);
+    lsk::TraceContext local = context;
+    for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray_counted(local, accel, rays[i], any_hit);
+    if (counters && accel.spec.line_space()) {
+      std::lock_guard<std::mutex> lock(mutex);
+      add_counters(*counters, local.ls_counters);
+    }
   });
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "bvh_builder.h"
+#include "line_space_builder.h"
 #include "scene.h"
 #include "structure_name.h"
 #include "trace_context.h"
@@ -27,19 +28,39 @@ struct Accel {
   size_t instance_count = 0;
   size_t world_triangles = 0;
   int max_depth = 0;                        // deepest BVH (object BVHs for 2L)
-  double build_seconds = 0.0;
+  double build_seconds = 0.0;               // everything, Line Space included
+
+  // Line Space (F-LS, 2L-LS): see line_space_builder.h and common/kernels/ls_lookup.h.
+  std::vector<uint32_t> node_ls;            // per BVH node: its LsNode, or LS_INVALID
+  std::vector<lsk::LsNode> ls_nodes;
+  std::vector<uint32_t> ls_candidates;      // packed per LsNode
+  std::vector<glm::uvec4> tri_normals;      // octahedral vertex normals per triangle (BVH order)
+  LsOptions ls_options;
+  LsBuildInfo ls_info;
 
   size_t bytes_total() const;
-  size_t bytes_ls() const { return 0; }
+  size_t bytes_ls() const;
   lsk::TraceContext context() const;
 };
 
-// Builds F-BVH or 2L-BVH.  Line Space structures throw InputError until they are implemented.
-Accel build_accel(const Scene& scene, const StructureSpec& spec, const BvhBuildOptions& options = {});
+struct AccelOptions {
+  BvhBuildOptions bvh;
+  LsOptions ls;
+  AccelOptions() = default;
+  AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
+};
 
+// Builds any of the four structures of DESIGN §3.
+Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options = {});
+
+// One ray.  The first form discards Line Space counters; the second adds them to context.ls_counters.
 lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
+lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 
-// Traces a batch on all threads (TBB).
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit);
+// Traces a batch on all threads (TBB); Line Space counters are added to *counters when given.
+void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+                lsk::LsCounters* counters = nullptr);
+
+void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from);
 
 }  // namespace ls

@@ -24,7 +24,7 @@ std::string cpu_model() {
 }
 
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats) {
+                      int repeats, const AccelOptions& options) {
   BenchResult result;
   result.rays = rays.size();
   result.threads = tbb::info::default_concurrency();
@@ -32,7 +32,7 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   result.cpu = cpu_model();
 
   std::vector<Accel> built;
-  for (const StructureSpec& spec : structures) built.push_back(build_accel(scene, spec));
+  for (const StructureSpec& spec : structures) built.push_back(build_accel(scene, spec, options));
   EmbreeTracer embree(scene);
 
   std::vector<lsk::Hit> hits(rays.size());

@@ -3,6 +3,7 @@
 // alike, and the median is reported.
 #pragma once
 
+#include "accel.h"
 #include "kernels/layouts.h"
 #include "scene.h"
 #include "structure_name.h"
@@ -29,7 +30,7 @@ struct BenchResult {
 };
 
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats);
+                      int repeats, const AccelOptions& options = {});
 
 std::string cpu_model();
 

@@ -51,19 +51,28 @@ void print_build(const Accel& a, bool json) {
                      {"instances", a.instance_count},
                      {"nodes", a.nodes.size() + a.top_nodes.size()},
                      {"max_depth", a.max_depth},
-                     {"ls_nodes", 0},
-                     {"shafts_per_ls", 0},
+                     {"ls_nodes", a.ls_info.ls_nodes},
+                     {"shafts_per_ls", a.ls_info.shafts_per_ls},
+                     {"empty_shafts", a.ls_info.empty_shafts},
                      {"bytes_total", a.bytes_total()},
                      {"bytes_ls", a.bytes_ls()},
+                     {"bytes_ls_candidates", a.ls_info.candidate_bytes},
+                     {"bytes_ls_candidates_paper", a.ls_info.candidate_bytes_paper},
+                     {"bytes_ls_candidates_compact", a.ls_info.candidate_bytes_compact},
+                     {"ls_build_seconds", a.ls_info.seconds},
+                     {"ls_shafts_per_second", a.ls_info.seconds > 0.0 ? double(a.ls_info.ls_nodes * a.ls_info.shafts_per_ls) / a.ls_info.seconds : 0.0},
                      {"build_seconds", a.build_seconds}};
     std::cout << j.dump(2) << "\n";
     return;
   }
   std::printf("structure      %s\ntriangles      %zu\nobjects        %zu\ninstances      %zu\nnodes          %zu\n"
-              "max_depth      %d\nls_nodes       0\nshafts_per_ls  0\nbytes_total    %zu (%.2f MB)\nbytes_ls       %zu\n"
-              "build_seconds  %.3f\n",
+              "max_depth      %d\nls_nodes       %zu\nshafts_per_ls  %zu\nempty_shafts   %zu\n"
+              "bytes_total    %zu (%.2f MB)\nbytes_ls       %zu (%.2f MB; candidates %.2f MB, paper mode %.2f MB)\n"
+              "build_seconds  %.3f (Line Space %.3f)\n",
               a.spec.name().c_str(), a.world_triangles, a.objects, a.instance_count, a.nodes.size() + a.top_nodes.size(),
-              a.max_depth, a.bytes_total(), double(a.bytes_total()) / 1e6, a.bytes_ls(), a.build_seconds);
+              a.max_depth, a.ls_info.ls_nodes, a.ls_info.shafts_per_ls, a.ls_info.empty_shafts, a.bytes_total(),
+              double(a.bytes_total()) / 1e6, a.bytes_ls(), double(a.bytes_ls()) / 1e6, double(a.ls_info.candidate_bytes) / 1e6,
+              double(a.ls_info.candidate_bytes_paper) / 1e6, a.build_seconds, a.ls_info.seconds);
 }
 
 void print_bench(const BenchResult& r, bool json) {
@@ -88,6 +97,45 @@ void print_bench(const BenchResult& r, bool json) {
                 double(e.bytes) / 1e6, e.build_seconds);
 }
 
+// Line Space options shared by every subcommand that builds a structure.
+struct LsFlags {
+  double angle = LsOptions{}.angle_degrees;
+  int further_rays = LsOptions{}.further_rays;
+  uint32_t min_triangles = LsOptions{}.min_triangles;
+  std::string candidates = "compact";
+  double max_memory_mb = 0.0;
+
+  void add_to(CLI::App* app) {
+    app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
+        ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+    app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
+        ->capture_default_str()->check(CLI::Range(0, 1024));
+    app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
+        ->capture_default_str();
+    app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
+        ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
+    app->add_option("--max-memory", max_memory_mb, "refuse a Line Space estimated above this many MB (0: half of RAM)")
+        ->check(CLI::Range(0.0, 1e9));
+  }
+  AccelOptions options() const {
+    AccelOptions o;
+    o.ls.angle_degrees = float(angle);
+    o.ls.further_rays = further_rays;
+    o.ls.min_triangles = min_triangles;
+    o.ls.paper_candidates = candidates == "paper";
+    o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    return o;
+  }
+};
+
+void print_counters(const lsk::LsCounters& c) {
+  std::fprintf(stderr,
+               "line space: %u lookups, %u empty shafts, %u accepted, refused %u (angle %u, interval %u, parallel %u, "
+               "no shaft %u)\n",
+               c.lookups, c.empty, c.accepted, c.refused_angle + c.refused_interval + c.refused_parallel + c.refused_no_shaft,
+               c.refused_angle, c.refused_interval, c.refused_parallel, c.refused_no_shaft);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -96,15 +144,18 @@ int main(int argc, char** argv) {
   std::string scene_spec = "builtin:cornell";
   std::string structure = "bvh";
   bool json = false;
+  LsFlags ls_flags;
 
   auto* build = app.add_subcommand("build", "build a structure and print its size and build time");
+  ls_flags.add_to(build);
   build->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
-  build->add_option("--structure", structure, "bvh, 2l-bvh (f-ls:D:N, 2l-ls:D:N: Line Space issue)")->capture_default_str();
+  build->add_option("--structure", structure, "bvh, 2l-bvh, f-ls:D:N or 2l-ls:D:N")->capture_default_str();
   build->add_flag("--json", json, "machine-readable output");
 
   std::string rays_path, hits_path;
   bool any_hit = false;
   auto* trace = app.add_subcommand("trace", "trace a ray file, write a hit file");
+  ls_flags.add_to(trace);
   trace->add_option("--scene", scene_spec)->capture_default_str();
   trace->add_option("--structure", structure)->capture_default_str();
   trace->add_option("--rays", rays_path, "ray file (32-byte records)")->required();
@@ -125,6 +176,7 @@ int main(int argc, char** argv) {
   int spp = 16, bounces = 3;
   bool quiet = false;
   auto* render_cmd = app.add_subcommand("render", "path trace; write EXRs per bounce, a PNG and report.json");
+  ls_flags.add_to(render_cmd);
   render_cmd->add_option("--scene", scene_spec)->capture_default_str();
   render_cmd->add_option("--schedule", schedule, "structure per bounce, comma-separated, last repeats")->capture_default_str();
   render_cmd->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 16));
@@ -137,6 +189,7 @@ int main(int argc, char** argv) {
   std::string structures = "bvh,2l-bvh";
   int repeats = 5;
   auto* bench = app.add_subcommand("bench", "MRays/s of each structure beside Embree 3 on the same rays");
+  ls_flags.add_to(bench);
   bench->add_option("--scene", scene_spec)->capture_default_str();
   bench->add_option("--rays", rays_path, "ray file (default: diffuse rays made here)");
   bench->add_option("--count", count, "diffuse rays to make when --rays is not given")->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
@@ -157,12 +210,14 @@ int main(int argc, char** argv) {
   try {
     const Scene scene = load_scene(scene_spec);
     if (*build) {
-      print_build(build_accel(scene, parse_structure(structure)), json);
+      print_build(build_accel(scene, parse_structure(structure), ls_flags.options()), json);
     } else if (*trace) {
-      const Accel accel = build_accel(scene, parse_structure(structure));
+      const Accel accel = build_accel(scene, parse_structure(structure), ls_flags.options());
       const std::vector<lsk::Ray> in = read_rays(rays_path);
       std::vector<lsk::Hit> out(in.size());
-      trace_rays(accel, in.data(), out.data(), in.size(), any_hit);
+      lsk::LsCounters counters{};
+      trace_rays(accel, in.data(), out.data(), in.size(), any_hit, &counters);
+      if (accel.spec.line_space()) print_counters(counters);
       write_hits(hits_path, out);
       size_t found = 0;
       for (const lsk::Hit& h : out) found += h.triangle != lsk::LS_INVALID;
@@ -182,7 +237,7 @@ int main(int argc, char** argv) {
       options.spp = spp;
       options.bounces = bounces;
       options.seed = seed;
-      std::map<std::string, Accel> built = build_schedule_structures(scene, options.schedule);
+      std::map<std::string, Accel> built = build_schedule_structures(scene, options.schedule, ls_flags.options());
       const bool show = !quiet && isatty(2);
       Progress progress = [&](int done, int total) {
         if (!show) return;
@@ -211,7 +266,7 @@ int main(int argc, char** argv) {
         bench_rays = generate_rays(scene, exact, RayKind::Diffuse, count, seed);
       }
       if (bench_rays.empty()) throw InputError("bench: the ray file holds no rays");
-      print_bench(run_bench(scene, bench_rays, specs, repeats), json);
+      print_bench(run_bench(scene, bench_rays, specs, repeats, ls_flags.options()), json);
     }
   } catch (const InputError& e) {
     std::cerr << "linespace-cpu: " << e.what() << "\n";

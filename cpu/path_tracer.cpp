@@ -106,10 +106,11 @@ double RenderResult::indirect_mrays_per_s() const {
   return s > 0.0 ? double(indirect_rays()) / s * 1e-6 : 0.0;
 }
 
-std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule) {
+std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule,
+                                                       const AccelOptions& options) {
   std::map<std::string, Accel> built;
   for (const StructureSpec& spec : schedule.per_bounce)
-    if (!built.count(spec.name())) built.emplace(spec.name(), build_accel(scene, spec));
+    if (!built.count(spec.name())) built.emplace(spec.name(), build_accel(scene, spec, options));
   return built;
 }
 
@@ -171,7 +172,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       batch.resize(active.size());
       batch_hits.resize(active.size());
       for (size_t i = 0; i < active.size(); ++i) batch[i] = paths[active[i]].ray;
-      stats.trace_seconds += timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), false); });
+      stats.trace_seconds += timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), false, &stats.ls); });
       stats.extension_rays += active.size();
 
       // Shade: emission found, a light sample for next-event estimation, the next direction.
@@ -259,7 +260,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       batch.resize(active.size());
       batch_hits.resize(active.size());
       for (size_t i = 0; i < active.size(); ++i) batch[i] = shadows[active[i]].ray;
-      stats.trace_seconds += timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), true); });
+      stats.trace_seconds += timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), true, &stats.ls); });
       stats.shadow_rays += active.size();
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;

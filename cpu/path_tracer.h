@@ -40,6 +40,7 @@ struct BounceStats {
   uint64_t shadow_rays = 0;
   double trace_seconds = 0.0;   // wall-clock time spent inside trace batches
   std::string structure;
+  lsk::LsCounters ls{};         // Line Space lookups of this bounce's rays
 };
 
 struct RenderResult {
@@ -62,6 +63,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
                     const Progress& progress = {});
 
 // Builds each distinct structure of the schedule once.
-std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule);
+std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule,
+                                                       const AccelOptions& options = {});
 
 }  // namespace ls

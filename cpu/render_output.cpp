@@ -22,6 +22,13 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
                           {"shadow_rays", b.shadow_rays},
                           {"rays", rays},
                           {"seconds", b.trace_seconds},
+                          {"ls_lookups", b.ls.lookups},
+                          {"ls_empty", b.ls.empty},
+                          {"ls_accepted", b.ls.accepted},
+                          {"ls_refused_angle", b.ls.refused_angle},
+                          {"ls_refused_interval", b.ls.refused_interval},
+                          {"ls_refused_parallel", b.ls.refused_parallel},
+                          {"ls_refused_no_shaft", b.ls.refused_no_shaft},
                           {"mrays_per_s", b.trace_seconds > 0.0 ? double(rays) / b.trace_seconds * 1e-6 : 0.0}});
   }
   json structures = json::array();
@@ -30,7 +37,9 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
       structures.push_back({{"structure", name},
                             {"build_seconds", accel.build_seconds},
                             {"bytes_total", accel.bytes_total()},
-                            {"bytes_ls", accel.bytes_ls()}});
+                            {"bytes_ls", accel.bytes_ls()},
+                            {"ls_nodes", accel.ls_info.ls_nodes},
+                            {"shafts_per_ls", accel.ls_info.shafts_per_ls}});
   const BounceStats& primary = result.bounces.front();
   return json{{"scene", context.scene},
               {"schedule", context.schedule},

@@ -2,7 +2,9 @@
 // inside this struct, so `nodes[i]` in the kernel reads the pointer member here and the buffer there.
 #pragma once
 
+#include "kernels/hit.h"
 #include "kernels/layouts.h"
+#include "kernels/line_space.h"
 #include "kernels/ray_box.h"
 #include "kernels/ray_triangle.h"
 
@@ -15,8 +17,19 @@ struct TraceContext {
   const uint* tri_instances = nullptr;
   const BvhNode* top_nodes = nullptr;
   const InstanceRecord* instances = nullptr;
+  // Line Space (LS structures only)
+  const uint* node_ls = nullptr;
+  const LsNode* ls_nodes = nullptr;
+  const uint* ls_candidates = nullptr;
+  const uvec4* tri_normals = nullptr;
+  uint ls_enabled = 0;
+  uint ls_n = 0;
+  float ls_cos2 = -1.0f;
+  LsCounters ls_counters{};  // the shader keeps these in a private variable too
 
+#include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"
+#include "kernels/ls_candidate_search.h"
 };
 
 }  // namespace lsk

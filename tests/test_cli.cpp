@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -19,10 +20,14 @@ struct Run {
   std::string out, err;
 };
 
+// Each test process gets its own folder: ctest runs test cases in parallel.
+fs::path temp(const std::string& name) {
+  return fs::temp_directory_path() / ("linespace_cli_test_" + std::to_string(getpid())) / name;
+}
+
 Run run(const std::string& args) {
-  const fs::path dir = fs::temp_directory_path() / "linespace_cli_test";
-  fs::create_directories(dir);
-  const std::string out = (dir / "stdout").string(), err = (dir / "stderr").string();
+  fs::create_directories(temp(""));
+  const std::string out = temp("stdout").string(), err = temp("stderr").string();
   const std::string cmd = std::string(LINESPACE_CPU) + " " + args + " >" + out + " 2>" + err;
   const int raw = std::system(cmd.c_str());
   Run r;
@@ -35,8 +40,6 @@ Run run(const std::string& args) {
   r.err = slurp(err);
   return r;
 }
-
-fs::path temp(const std::string& name) { return fs::temp_directory_path() / "linespace_cli_test" / name; }
 
 void write_text(const fs::path& p, const std::string& text) {
   std::ofstream f(p, std::ios::binary);

@@ -17,6 +17,7 @@
 #ifdef __cplusplus
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 namespace lsk {
@@ -36,6 +37,7 @@ using glm::clamp;
 using glm::cross;
 using glm::dot;
 using glm::floatBitsToInt;
+using glm::floor;
 using glm::floatBitsToUint;
 using glm::intBitsToFloat;
 using glm::isinf;
@@ -47,6 +49,7 @@ using glm::max;
 using glm::min;
 using glm::normalize;
 using glm::sqrt;
+using glm::unpackSnorm2x16;
 inline float inversesqrt(float x) { return 1.0f / std::sqrt(x); }
 }  // namespace lsk
 

@@ -60,6 +60,35 @@ struct InstanceRecord {
   uint pad;
 };
 
+// A Line Space attached to one BVH node (DESIGN §3).  Its box is the node's box, widened where it is
+// thin so that a flat node (one quad) still has shafts that cross it.  Candidates are stored per shaft
+// as an index local to the node's contiguous triangle range, in `bytes` bytes (1, 2 or 4, packed
+// little-endian into 32-bit words; all ones = empty shaft).
+struct LsNode {
+  vec3 lo;
+  uint candidates;   // first 32-bit word of this node's candidates in ls_candidates[]
+  vec3 hi;
+  uint range_first;  // first triangle (index into tris[]) of the node's subtree
+  vec3 scale;        // N / (hi - lo) per axis: patch coordinates without dividing on the device
+  uint range_count;
+  uint bytes;
+  uint node;         // the BVH node it belongs to
+  uint pad0;
+  uint pad1;
+};
+
+// Counters of Line Space lookups, per trace call (summed by the host).
+struct LsCounters {
+  uint lookups;
+  uint empty;             // empty shaft: no hit in the subtree
+  uint accepted;          // the candidate's plane gave the hit
+  uint refused_angle;     // extrapolated normal too far from the ray
+  uint refused_interval;  // plane hit outside [tmin, current t]
+  uint refused_parallel;  // ray parallel to the candidate's plane
+  uint refused_no_shaft;  // line along a face of the LS box (enters and leaves through one face)
+  uint pad;
+};
+
 // A pinhole camera: world position, orthonormal frame, tan(vertical fov / 2), image size.
 struct CameraFrame {
   vec3 position;

@@ -48,15 +48,28 @@ LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(ve
   a = scale_pow2(a, ks);
   b = scale_pow2(b, ks);
   c = scale_pow2(c, ks);
-  precise float e0 = dot(r.dir, cross(b, c));
-  precise float e1 = dot(r.dir, cross(c, a));
-  precise float e2 = dot(r.dir, cross(a, b));
+  // Edge functions in Pluecker form: cross(b + c, c - b) = 2 cross(b, c), but its products are
+  // (distance x edge length) rather than (distance x distance), so the rounding error grows linearly,
+  // not quadratically, with distance / triangle size (Embree's robust intersector does the same).
+  // Swapping an edge's endpoints still negates the value exactly (b + c = c + b, c - b = -(b - c)):
+  // watertight as before.
+  precise float e0 = dot(r.dir, cross(b + c, c - b));
+  precise float e1 = dot(r.dir, cross(c + a, a - c));
+  precise float e2 = dot(r.dir, cross(a + b, b - a));
   if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
   precise float det = e0 + e1 + e2;
   if (det == 0.0f) return false;
-  // The hit point is (e0 a + e1 b + e2 c) / det = t' dir, so t' = T / (det |dir|^2).
-  precise float T = e0 * dot(a, r.dir) + e1 * dot(b, r.dir) + e2 * dot(c, r.dir);
-  precise float D = det * dot(r.dir, r.dir);
+  // t from the plane: n from the untranslated edges (exact to a few ulps of the edge), scaled by a
+  // power of two; t' = dot(n, a) / dot(n, dir).
+  precise vec3 f1 = p1 - p0;
+  precise vec3 f2 = p2 - p0;
+  int kf = unit_exponent(max(max_abs(f1), max_abs(f2)));
+  f1 = scale_pow2(f1, kf);
+  f2 = scale_pow2(f2, kf);
+  precise vec3 n = cross(f1, f2);
+  precise float T = dot(n, a);
+  precise float D = dot(n, r.dir);
+  if (D == 0.0f) return false;
   if (D < 0.0f) {
     T = -T;
     D = -D;

@@ -9,29 +9,20 @@
 //   tri_instances[]  uint      instance id per triangle (flat structures only)
 //   top_nodes[]      BvhNode   the top-level BVH over instances (2L only); leaves index instances[]
 //   instances[]      InstanceRecord, in top-level BVH order (2L only)
+//   node_ls[]        uint      LS node of each BVH node, or LS_INVALID (LS structures only)
+//   ls_enabled       uint      non-zero: use the Line Space (see ls_lookup.h for the rest)
 // Ties at equal t go to the lower (instance, triangle), so the answer does not depend on the order in
 // which the structure visits triangles.
 
 LS_CONST int LS_STACK_SIZE = 64;  // the builder caps BVH depth below this
 
-// Offers a triangle hit to the running result; true when it became the result.
-LS_FN bool offer_hit(float t, float u, float v, uint instance, uint triangle, INOUT(Hit) hit) {
-  // ray_triangle never returns t > hit.t, so "not closer" means "equal": then the lower id wins.
-  if (t < hit.t || instance < hit.instance || (instance == hit.instance && triangle < hit.triangle)) {
-    hit.t = t;
-    hit.u = u;
-    hit.v = v;
-    hit.instance = instance;
-    hit.triangle = triangle;
-    return true;
-  }
-  return false;
-}
-
 // Traverses the BVH rooted at nodes[root] with a ray given in that BVH's space.  instance is the id
-// to report, or LS_INVALID to read it per triangle (flat structures).  Returns true when any_hit is
-// set and a hit was found (the caller stops).
-LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint instance, bool any_hit, INOUT(Hit) hit) {
+// to report, or LS_INVALID to read it per triangle (flat structures).  With use_ls, a node that
+// carries a Line Space is answered by its lookup, and traversed exactly only when the lookup refuses.
+// hit_prim receives the tris[] index of the hit.  Returns true when any_hit is set and a hit was
+// found (the caller stops).
+LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint instance, bool any_hit, bool use_ls,
+                     INOUT(Hit) hit, INOUT(uint) hit_prim) {
   TriRay tri_ray = make_tri_ray(origin, dir);
   vec3 inv_dir = safe_reciprocal(dir);
   uint stack_node[LS_STACK_SIZE];
@@ -42,7 +33,15 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
   uint current = root;
   while (true) {
     BvhNode node = nodes[current];
-    if (node.count > 0u) {
+    bool descend = true;
+    if (use_ls && node_ls[current] != LS_INVALID) {
+      uint answer = ls_lookup(node_ls[current], origin, dir, inv_dir, tmin, instance, hit, hit_prim);
+      if (answer == LS_ACCEPTED && any_hit) return true;
+      descend = answer == LS_FALLBACK;
+    }
+    if (!descend) {
+      // answered by the Line Space: continue with the stack
+    } else if (node.count > 0u) {
       for (uint i = node.first; i < node.first + node.count; ++i) {
         Triangle tri = tris[i];
         float t;
@@ -50,7 +49,10 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
         float v;
         if (ray_triangle(tri_ray, tmin, hit.t, vec3(tri.v0), vec3(tri.v1), vec3(tri.v2), t, u, v)) {
           uint inst = instance == LS_INVALID ? tri_instances[i] : instance;
-          if (offer_hit(t, u, v, inst, tri_ids[i], hit) && any_hit) return true;
+          if (offer_hit(t, u, v, inst, tri_ids[i], hit)) {
+            hit_prim = i;
+            if (any_hit) return true;
+          }
         }
       }
     } else {
@@ -87,32 +89,17 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
   return false;
 }
 
-LS_FN Hit empty_hit(IN(Ray) ray) {
-  Hit hit;
-  hit.t = ray.tmax;
-  hit.instance = LS_INVALID;
-  hit.triangle = LS_INVALID;
-  hit.u = 0.0f;
-  hit.v = 0.0f;
-  return hit;
-}
-
-// A miss reports t = +inf (DESIGN §9).
-LS_FN Hit finish_hit(IN(Hit) hit) {
-  Hit h = hit;
-  if (h.triangle == LS_INVALID) h.t = ls_infinity();
-  return h;
-}
-
 LS_FN Hit trace_flat(IN(Ray) ray, bool any_hit) {
   Hit hit = empty_hit(ray);
-  trace_bvh(0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, any_hit, hit);
+  uint prim = LS_INVALID;
+  trace_bvh(0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, any_hit, ls_enabled != 0u, hit, prim);
   return finish_hit(hit);
 }
 
 // The ray is carried into each instance's object space; an affine map keeps t unchanged.
 LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
   Hit hit = empty_hit(ray);
+  uint prim = LS_INVALID;
   vec3 inv_dir = safe_reciprocal(ray.dir);
   uint stack_node[LS_STACK_SIZE];
   float stack_t[LS_STACK_SIZE];
@@ -131,7 +118,7 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
         precise vec3 d = vec3(dot(rec.world_to_object0, vec4(ray.dir, 0.0f)),
                               dot(rec.world_to_object1, vec4(ray.dir, 0.0f)),
                               dot(rec.world_to_object2, vec4(ray.dir, 0.0f)));
-        if (trace_bvh(rec.root, o, d, ray.tmin, rec.instance, any_hit, hit)) return finish_hit(hit);
+        if (trace_bvh(rec.root, o, d, ray.tmin, rec.instance, any_hit, ls_enabled != 0u, hit, prim)) return finish_hit(hit);
       }
     } else {
       uint left = node.first;

@@ -1,0 +1,102 @@
+// The Line Space lookup during traversal (DESIGN §3), a *context* file like traverse_bvh.h: it reads
+//   ls_nodes[] LsNode, ls_candidates[] uint, tri_normals[] uvec4 (octahedral vertex normals),
+//   tris[], tri_ids[], tri_instances[], and the parameters ls_n (N), ls_cos2 (cos^2 of the refusal
+//   angle; negative: refuse everything, empty shafts included) and the counters ls_counters.
+//
+// Decided cases: the shaft comes from where the ray's *line* enters and leaves the LS box, so an
+// origin inside the box still finds its shaft.  An empty shaft means no hit in the subtree.  A
+// candidate is used as an infinite plane: the hit is refused, and the subtree traversed exactly, when
+// the ray is parallel to the plane, when the plane hit lies outside [tmin, current t] (behind the
+// origin, beyond tmax, or farther than a hit already found), when the line runs along a face of the
+// box (no shaft), or when the angle between the ray and the candidate's vertex normals extrapolated
+// to the plane hit exceeds the refusal angle.
+
+LS_CONST uint LS_FALLBACK = 0u;
+LS_CONST uint LS_EMPTY = 1u;
+LS_CONST uint LS_ACCEPTED = 2u;
+
+// Octahedral unit-vector decoding (Cigolle et al., JCGT 2014).
+LS_FN vec3 ls_decode_normal(uint packed) {
+  vec2 e = unpackSnorm2x16(packed);
+  vec3 v = vec3(e.x, e.y, 1.0f - abs(e.x) - abs(e.y));
+  if (v.z < 0.0f) {
+    float x = (1.0f - abs(e.y)) * (e.x >= 0.0f ? 1.0f : -1.0f);
+    float y = (1.0f - abs(e.x)) * (e.y >= 0.0f ? 1.0f : -1.0f);
+    v.x = x;
+    v.y = y;
+  }
+  return normalize(v);
+}
+
+// The candidate of a shaft as an index into tris[], or LS_INVALID for an empty shaft.
+LS_FN uint ls_candidate(IN(LsNode) ls, uint shaft) {
+  if (ls.bytes == 4u) {
+    uint v = ls_candidates[ls.candidates + shaft];
+    return v == LS_INVALID ? LS_INVALID : ls.range_first + v;
+  }
+  uint per_word = 4u / ls.bytes;
+  uint word = ls_candidates[ls.candidates + shaft / per_word];
+  uint bits = ls.bytes * 8u;
+  uint mask = (1u << bits) - 1u;
+  uint local = (word >> ((shaft % per_word) * bits)) & mask;
+  return local == mask ? LS_INVALID : ls.range_first + local;
+}
+
+// One lookup at an LS node: LS_ACCEPTED (hit updated), LS_EMPTY (skip the subtree) or LS_FALLBACK
+// (traverse the subtree exactly).
+LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, float tmin, uint instance,
+                     INOUT(Hit) hit, INOUT(uint) hit_prim) {
+  LsNode ls = ls_nodes[ls_index];
+  ls_counters.lookups += 1u;
+  // A refusal angle of 0 refuses every approximation, the "no hit" of an empty shaft included, so
+  // the structure answers exactly like its BVH.
+  if (ls_cos2 < 0.0f) {
+    ls_counters.refused_angle += 1u;
+    return LS_FALLBACK;
+  }
+  uint shaft;
+  float t_in;
+  float t_out;
+  if (!ls_line_shaft(origin, dir, inv_dir, ls.lo, ls.hi, ls.scale, ls_n, shaft, t_in, t_out)) {
+    ls_counters.refused_no_shaft += 1u;
+    return LS_FALLBACK;
+  }
+  uint prim = ls_candidate(ls, shaft);
+  if (prim == LS_INVALID) {
+    ls_counters.empty += 1u;
+    return LS_EMPTY;
+  }
+  Triangle tri = tris[prim];
+  vec3 p0 = vec3(tri.v0);
+  vec3 e1 = vec3(tri.v1) - p0;
+  vec3 e2 = vec3(tri.v2) - p0;
+  vec3 n = cross(e1, e2);
+  float denom = dot(dir, n);
+  if (denom == 0.0f || dot(n, n) == 0.0f) {
+    ls_counters.refused_parallel += 1u;
+    return LS_FALLBACK;
+  }
+  float t = dot(p0 - origin, n) / denom;
+  if (!(t >= tmin && t <= hit.t)) {
+    ls_counters.refused_interval += 1u;
+    return LS_FALLBACK;
+  }
+  // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
+  vec3 q = origin + dir * t - p0;
+  float nn = dot(n, n);
+  float b1 = dot(cross(q, e2), n) / nn;
+  float b2 = dot(cross(e1, q), n) / nn;
+  float b0 = 1.0f - b1 - b2;
+  uvec4 packed = tri_normals[prim];
+  vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
+  float c = dot(dir, ne);
+  float ne2 = dot(ne, ne);
+  if (ne2 == 0.0f || c * c < ls_cos2 * dot(dir, dir) * ne2) {
+    ls_counters.refused_angle += 1u;
+    return LS_FALLBACK;
+  }
+  uint inst = instance == LS_INVALID ? tri_instances[prim] : instance;
+  if (offer_hit(t, b1, b2, inst, tri_ids[prim], hit)) hit_prim = prim;
+  ls_counters.accepted += 1u;
+  return LS_ACCEPTED;
+}

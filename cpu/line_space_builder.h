@@ -1,0 +1,46 @@
+// Builds the Line Space of an F-LS or 2L-LS structure (DESIGN §3, paper §3.1–3.2): an LsNode for every
+// BVH node at integration depth D (of the flat BVH, or of every unique object's BVH, stored once per
+// mesh however many instances use it), and one candidate per shaft found by the single-source search
+// kernel (common/kernels/ls_candidate_search.h), in parallel with TBB.
+#pragma once
+
+#include "scene.h"
+#include "kernels/layouts.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace ls {
+
+struct Accel;
+
+struct LsOptions {
+  // Defaults chosen by measurement: see README, "Line Space parameters".
+  int further_rays = 8;          // search rays after the midpoint ray
+  float angle_degrees = 60.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
+  uint32_t min_triangles = 0;    // subtrees with fewer triangles get no LS (0: the paper's behaviour)
+  bool paper_candidates = false; // 4-byte candidates instead of the compact 1/2/4-byte local index
+  size_t max_memory = 0;         // refuse above this estimate (0: half of physical memory)
+};
+
+struct LsBuildInfo {
+  size_t ls_nodes = 0;
+  size_t shafts_per_ls = 0;
+  size_t empty_shafts = 0;
+  size_t candidate_bytes = 0;        // as stored
+  size_t candidate_bytes_paper = 0;  // at 4 bytes per shaft
+  size_t candidate_bytes_compact = 0;
+  double seconds = 0.0;
+};
+
+// Adds the Line Space to an exact structure that build_accel() made.  Throws InputError when the
+// estimated memory exceeds the budget, before allocating anything large.
+void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel);
+
+// Bytes the Line Space of `ls_nodes` nodes at subdivision n would take (candidates at 4 bytes).
+size_t estimate_line_space_bytes(size_t ls_nodes, int n);
+
+size_t physical_memory_bytes();
+
+}  // namespace ls

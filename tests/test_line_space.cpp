@@ -1,0 +1,352 @@
+// The Line Space against brute force and against the exact structures, at the extremes.
+#include "accel.h"
+#include "kernels/line_space.h"
+
+#include <catch2/catch.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <set>
+
+using namespace ls;
+
+namespace {
+
+float uniform(std::mt19937& rng) { return float(rng() >> 8) * (1.0f / 16777216.0f); }
+
+Scene single_mesh_scene(Mesh mesh, const std::vector<glm::mat4>& transforms = {glm::mat4(1.0f)}) {
+  Scene s;
+  s.name = "test";
+  s.materials.push_back(Material{});
+  mesh.materials.assign(mesh.triangles.size(), 0);
+  if (mesh.normals.size() != mesh.positions.size()) mesh.normals.assign(mesh.positions.size(), glm::vec3(0, 0, 1));
+  s.meshes.push_back(mesh);
+  for (const glm::mat4& m : transforms) s.instances.push_back(Instance{0, m, ""});
+  validate_scene(s);
+  return s;
+}
+
+// Random small triangles clustered in the unit cube, normals from the faces.
+Mesh random_soup(int count, uint32_t seed, float size = 0.08f) {
+  std::mt19937 rng(seed);
+  Mesh m;
+  for (int i = 0; i < count; ++i) {
+    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
+    glm::vec3 p[3];
+    for (auto& q : p) q = c + size * glm::vec3(uniform(rng) - 0.5f, uniform(rng) - 0.5f, uniform(rng) - 0.5f);
+    const glm::vec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+    for (auto& q : p) {
+      m.positions.push_back(q);
+      m.normals.push_back(n);
+    }
+    m.triangles.push_back(glm::uvec3(3 * i, 3 * i + 1, 3 * i + 2));
+  }
+  return m;
+}
+
+// A planar grid in z = 0 over [-1, 1]^2.
+Mesh plane_grid(int cells) {
+  Mesh m;
+  for (int y = 0; y <= cells; ++y)
+    for (int x = 0; x <= cells; ++x) {
+      m.positions.push_back(glm::vec3(-1.0f + 2.0f * float(x) / float(cells), -1.0f + 2.0f * float(y) / float(cells), 0.0f));
+      m.normals.push_back(glm::vec3(0, 0, 1));
+    }
+  for (int y = 0; y < cells; ++y)
+    for (int x = 0; x < cells; ++x) {
+      const uint32_t a = uint32_t(y * (cells + 1) + x), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
+      m.triangles.push_back(glm::uvec3(a, b, d));
+      m.triangles.push_back(glm::uvec3(a, d, c));
+    }
+  return m;
+}
+
+std::vector<lsk::Ray> random_rays(size_t count, uint32_t seed, glm::vec3 lo = glm::vec3(-0.5f), glm::vec3 hi = glm::vec3(1.5f)) {
+  std::mt19937 rng(seed);
+  std::vector<lsk::Ray> rays(count);
+  for (lsk::Ray& r : rays) {
+    for (int a = 0; a < 3; ++a) r.origin[a] = lo[a] + (hi[a] - lo[a]) * uniform(rng);
+    glm::vec3 d;
+    do d = glm::vec3(uniform(rng), uniform(rng), uniform(rng)) * 2.0f - 1.0f;
+    while (glm::dot(d, d) < 1e-4f || glm::dot(d, d) > 1.0f);
+    r.dir = glm::normalize(d);
+    r.tmin = 0.0f;
+    r.tmax = lsk::ls_infinity();
+  }
+  return rays;
+}
+
+std::vector<lsk::Hit> trace_all(const Accel& a, const std::vector<lsk::Ray>& rays, bool any_hit = false,
+                                lsk::LsCounters* counters = nullptr) {
+  std::vector<lsk::Hit> hits(rays.size());
+  trace_rays(a, rays.data(), hits.data(), rays.size(), any_hit, counters);
+  return hits;
+}
+
+bool same_bits(const std::vector<lsk::Hit>& a, const std::vector<lsk::Hit>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0;
+}
+
+AccelOptions angle(float degrees) {
+  AccelOptions o;
+  o.ls.angle_degrees = degrees;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("the shaft index is a bijection onto 0..30 N^4 - 1 for N from 1 to 12", "[line_space]") {
+  for (uint32_t n = 1; n <= 12; ++n) {
+    const uint32_t patches = 6 * n * n, shafts = lsk::ls_shaft_count(n);
+    REQUIRE(shafts == 30 * n * n * n * n);
+    std::vector<char> seen(shafts, 0);
+    uint32_t pairs = 0;
+    for (uint32_t s = 0; s < patches; ++s)
+      for (uint32_t e = 0; e < patches; ++e) {
+        if (s / (n * n) == e / (n * n)) continue;  // same face: no shaft
+        const uint32_t idx = lsk::ls_shaft_index(s, e, n);
+        REQUIRE(idx < shafts);
+        REQUIRE(!seen[idx]);
+        seen[idx] = 1;
+        uint32_t s2, e2;
+        lsk::ls_shaft_patches(idx, n, s2, e2);
+        REQUIRE(s2 == s);
+        REQUIRE(e2 == e);
+        ++pairs;
+      }
+    REQUIRE(pairs == shafts);
+  }
+}
+
+TEST_CASE("a ray through two patch points finds that shaft", "[line_space]") {
+  const glm::vec3 lo(-1.0f, 0.5f, 2.0f), hi(3.0f, 0.75f, 7.0f);
+  for (uint32_t n : {1u, 2u, 3u, 6u, 10u}) {
+    const glm::vec3 scale = float(n) / (hi - lo);
+    const float inv_n = 1.0f / float(n);
+    uint32_t checked = 0;
+    for (uint32_t shaft = 0; shaft < lsk::ls_shaft_count(n); shaft += (n > 3 ? 97 : 1)) {
+      uint32_t s, e;
+      lsk::ls_shaft_patches(shaft, n, s, e);
+      for (float off : {0.5f, 0.1f, 0.9f}) {
+        const glm::vec3 a = lsk::ls_patch_point(lo, hi, s, n, inv_n, off, 1.0f - off);
+        const glm::vec3 b = lsk::ls_patch_point(lo, hi, e, n, inv_n, 1.0f - off, off);
+        // Start the ray outside, before a, so the entry is a genuine entry.
+        const glm::vec3 d = b - a;
+        const glm::vec3 o = a - 0.25f * d;
+        uint32_t found;
+        float t_in, t_out;
+        REQUIRE(lsk::ls_line_shaft(o, d, lsk::safe_reciprocal(d), lo, hi, scale, n, found, t_in, t_out));
+        INFO("n " << n << " shaft " << shaft << " offset " << off);
+        REQUIRE(found == shaft);
+        ++checked;
+      }
+    }
+    REQUIRE(checked > 0);
+  }
+}
+
+TEST_CASE("edge and corner and face-grazing lines map consistently", "[line_space]") {
+  const glm::vec3 lo(0.0f), hi(1.0f);
+  const uint32_t n = 4;
+  const glm::vec3 scale(4.0f);
+  uint32_t shaft;
+  float t_in, t_out;
+  // Through two opposite corners: enters at (0,0,0), ties go to the lowest axis -> face -X.
+  glm::vec3 d(1.0f, 1.0f, 1.0f);
+  REQUIRE(lsk::ls_line_shaft(glm::vec3(-1.0f), d, lsk::safe_reciprocal(d), lo, hi, scale, n, shaft, t_in, t_out));
+  uint32_t s, e;
+  lsk::ls_shaft_patches(shaft, n, s, e);
+  CHECK(s == lsk::ls_patch_index(0, 0, 0, n));          // -X face, corner patch
+  CHECK(e == lsk::ls_patch_index(1, n - 1, n - 1, n));  // +X face, far corner patch
+  CHECK(t_in == 1.0f);
+  CHECK(t_out == 2.0f);
+  // Along an edge of the box (y = 0, z = 0), axis-parallel: enters -X and leaves +X.
+  d = glm::vec3(1.0f, 0.0f, 0.0f);
+  REQUIRE(lsk::ls_line_shaft(glm::vec3(-1.0f, 0.0f, 0.0f), d, lsk::safe_reciprocal(d), lo, hi, scale, n, shaft, t_in, t_out));
+  lsk::ls_shaft_patches(shaft, n, s, e);
+  CHECK(s / (n * n) == 0u);
+  CHECK(e / (n * n) == 1u);
+  // Negative zero components behave like positive zeros.
+  d = glm::vec3(1.0f, -0.0f, -0.0f);
+  uint32_t shaft2;
+  REQUIRE(lsk::ls_line_shaft(glm::vec3(-1.0f, 0.0f, 0.0f), d, lsk::safe_reciprocal(d), lo, hi, scale, n, shaft2, t_in, t_out));
+  CHECK(shaft2 == shaft);
+  // A line lying in the face z = 0 along a diagonal enters -X/-Y and leaves +X/+Y: a valid shaft;
+  // a line that misses the box gives none.
+  d = glm::vec3(0.0f, 0.0f, 1.0f);
+  CHECK_FALSE(lsk::ls_line_shaft(glm::vec3(2.0f, 2.0f, -1.0f), d, lsk::safe_reciprocal(d), lo, hi, scale, n, shaft, t_in, t_out));
+}
+
+TEST_CASE("every stored candidate equals a brute-force search over its subtree", "[line_space]") {
+  for (bool two_level : {false, true})
+    for (int n : {1, 2, 3}) {
+      const Scene scene = single_mesh_scene(random_soup(300, 7 + uint32_t(n)));
+      StructureSpec spec = parse_structure(std::string(two_level ? "2l-ls:" : "f-ls:") + "2:" + std::to_string(n));
+      AccelOptions opt;
+      opt.ls.further_rays = 4;
+      const Accel a = build_accel(scene, spec, opt);
+      REQUIRE(a.ls_info.ls_nodes > 0);
+      const uint32_t un = uint32_t(n);
+      const float inv_n = 1.0f / float(n);
+      size_t compared = 0, nonempty = 0;
+      for (const lsk::LsNode& ls : a.ls_nodes) {
+        lsk::TraceContext c = a.context();
+        for (uint32_t shaft = 0; shaft < lsk::ls_shaft_count(un); ++shaft) {
+          uint32_t s, e;
+          lsk::ls_shaft_patches(shaft, un, s, e);
+          uint32_t expect = lsk::LS_INVALID;
+          for (uint32_t k = 0; k <= 4 && expect == lsk::LS_INVALID; ++k) {
+            const glm::vec4 off = lsk::ls_search_offsets(k);
+            const glm::vec3 p = lsk::ls_patch_point(ls.lo, ls.hi, s, un, inv_n, off.x, off.y);
+            const glm::vec3 q = lsk::ls_patch_point(ls.lo, ls.hi, e, un, inv_n, off.z, off.w);
+            const lsk::TriRay tr = lsk::make_tri_ray(p, q - p);
+            float best = 1.0f;
+            uint32_t best_id = lsk::LS_INVALID;
+            for (uint32_t i = ls.range_first; i < ls.range_first + ls.range_count; ++i) {
+              float t, u, v;
+              const lsk::Triangle& tri = a.tris[i];
+              if (lsk::ray_triangle(tr, 0.0f, best, glm::vec3(tri.v0), glm::vec3(tri.v1), glm::vec3(tri.v2), t, u, v) &&
+                  (t < best || best_id == lsk::LS_INVALID || a.tri_ids[i] < a.tri_ids[best_id])) {
+                best = t;
+                best_id = i;
+              }
+            }
+            expect = best_id;
+          }
+          const uint32_t got = c.ls_candidate(ls, shaft);
+          INFO("two_level " << two_level << " n " << n << " node " << ls.node << " shaft " << shaft);
+          REQUIRE(got == expect);
+          ++compared;
+          nonempty += got != lsk::LS_INVALID;
+        }
+      }
+      CHECK(nonempty > 0);
+      CHECK(nonempty < compared);
+    }
+}
+
+TEST_CASE("a refusal angle of 0 gives exactly the exact structure's hits", "[line_space]") {
+  const Scene scene = single_mesh_scene(random_soup(2000, 3), {glm::mat4(1.0f), glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 0.1f, 0.0f))});
+  const std::vector<lsk::Ray> rays = random_rays(20000, 11);
+  for (const char* pair : {"bvh f-ls:4:3", "bvh f-ls:0:6", "2l-bvh 2l-ls:2:4", "2l-bvh 2l-ls:0:1"}) {
+    const std::string p(pair);
+    const std::string exact_name = p.substr(0, p.find(' ')), ls_name = p.substr(p.find(' ') + 1);
+    const Accel exact = build_accel(scene, parse_structure(exact_name));
+    const Accel approx = build_accel(scene, parse_structure(ls_name), angle(0.0f));
+    REQUIRE(approx.ls_info.ls_nodes > 0);
+    INFO(ls_name);
+    lsk::LsCounters counters{};
+    REQUIRE(same_bits(trace_all(exact, rays), trace_all(approx, rays, false, &counters)));
+    REQUIRE(same_bits(trace_all(exact, rays, true), trace_all(approx, rays, true)));
+    CHECK(counters.lookups > 0);
+    CHECK(counters.accepted == 0);
+    CHECK(counters.empty == 0);
+  }
+}
+
+TEST_CASE("on one large planar mesh every accepted approximation lands on the plane", "[line_space]") {
+  const Scene scene = single_mesh_scene(plane_grid(64));
+  std::mt19937 rng(5);
+  std::vector<lsk::Ray> rays(20000);
+  for (lsk::Ray& r : rays) {
+    r.origin = glm::vec3(uniform(rng) * 4.0f - 2.0f, uniform(rng) * 4.0f - 2.0f, 0.5f + uniform(rng));
+    r.dir = glm::normalize(glm::vec3(uniform(rng) - 0.5f, uniform(rng) - 0.5f, -0.2f - uniform(rng)));
+    r.tmin = 0.0f;
+    r.tmax = lsk::ls_infinity();
+  }
+  for (const char* name : {"f-ls:3:6", "2l-ls:0:4", "f-ls:6:2"}) {
+    const Accel a = build_accel(scene, parse_structure(name), angle(89.0f));
+    lsk::LsCounters counters{};
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters);
+    INFO(name);
+    REQUIRE(counters.accepted > 0);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      if (hits[i].triangle == lsk::LS_INVALID) continue;
+      const float t_plane = -rays[i].origin.z / rays[i].dir.z;
+      REQUIRE(hits[i].t == Approx(t_plane).epsilon(1e-5));
+    }
+  }
+}
+
+TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves and N = 1", "[line_space]") {
+  // One quad: a box of zero thickness.  Its Line Space must still find it.
+  Mesh quad;
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const Scene flat = single_mesh_scene(quad);
+  std::vector<lsk::Ray> down;
+  for (int i = 0; i < 100; ++i) {
+    lsk::Ray r;
+    r.origin = glm::vec3(0.05f + 0.008f * float(i), 0.5f + 0.004f * float(i), 1.0f);  // all land on the quad
+    r.dir = glm::normalize(glm::vec3(0.1f, -0.05f, -1.0f));
+    r.tmin = 0.0f;
+    r.tmax = lsk::ls_infinity();
+    down.push_back(r);
+  }
+  for (const char* name : {"f-ls:0:1", "f-ls:0:6", "2l-ls:0:3", "2l-ls:0:2"}) {
+    const Accel a = build_accel(flat, parse_structure(name), angle(89.0f));
+    const Accel exact = build_accel(flat, parse_structure("bvh"));
+    INFO(name);
+    REQUIRE(a.ls_info.ls_nodes > 0);
+    const auto got = trace_all(a, down), want = trace_all(exact, down);
+    for (size_t i = 0; i < down.size(); ++i) {
+      REQUIRE(got[i].triangle != lsk::LS_INVALID);  // no ray slips through the flat LS
+      REQUIRE(got[i].t == Approx(want[i].t).epsilon(1e-5));
+    }
+  }
+  // Depth past the leaves: no LS node at all, and the exact structure's answers.
+  const Scene soup = single_mesh_scene(random_soup(500, 9));
+  const Accel deep = build_accel(soup, parse_structure("f-ls:40:2"));
+  REQUIRE(deep.ls_info.ls_nodes == 0);
+  const std::vector<lsk::Ray> rays = random_rays(5000, 4);
+  REQUIRE(same_bits(trace_all(deep, rays), trace_all(build_accel(soup, parse_structure("bvh")), rays)));
+  // D = 0: exactly one LS node per BVH (F) or per unique object (2L).
+  CHECK(build_accel(soup, parse_structure("f-ls:0:2")).ls_info.ls_nodes == 1);
+  CHECK(build_accel(soup, parse_structure("2l-ls:0:2")).ls_info.ls_nodes == 1);
+  // The minimum subtree size skips small nodes.
+  AccelOptions big_only;
+  big_only.ls.min_triangles = 1000;
+  CHECK(build_accel(soup, parse_structure("f-ls:0:2"), big_only).ls_info.ls_nodes == 0);
+}
+
+TEST_CASE("2L-LS stores one Line Space per unique mesh however many instances use it", "[line_space]") {
+  std::vector<glm::mat4> many;
+  for (int i = 0; i < 64; ++i)
+    many.push_back(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(float(i % 8) * 1.5f, float(i / 8) * 1.5f, 0.0f)),
+                               0.1f * float(i), glm::vec3(0, 1, 0)));
+  const Mesh mesh = random_soup(400, 21);
+  const Scene one = single_mesh_scene(mesh), sixty_four = single_mesh_scene(mesh, many);
+  const Accel a1 = build_accel(one, parse_structure("2l-ls:2:3")), a64 = build_accel(sixty_four, parse_structure("2l-ls:2:3"));
+  CHECK(a64.ls_info.ls_nodes == a1.ls_info.ls_nodes);
+  CHECK(a64.ls_candidates == a1.ls_candidates);
+  CHECK(a64.bytes_ls() == a1.bytes_ls());
+  // The flat LS grows with the instances.
+  CHECK(build_accel(sixty_four, parse_structure("f-ls:6:3")).ls_info.ls_nodes > a1.ls_info.ls_nodes);
+}
+
+TEST_CASE("compact and paper candidates give identical hits and compact is smaller", "[line_space]") {
+  const Scene scene = single_mesh_scene(random_soup(3000, 13));
+  AccelOptions paper;
+  paper.ls.paper_candidates = true;
+  for (const char* name : {"f-ls:3:4", "2l-ls:1:3"}) {
+    const Accel c = build_accel(scene, parse_structure(name)), p = build_accel(scene, parse_structure(name), paper);
+    const std::vector<lsk::Ray> rays = random_rays(10000, 8);
+    REQUIRE(same_bits(trace_all(c, rays), trace_all(p, rays)));
+    CHECK(c.ls_info.candidate_bytes < p.ls_info.candidate_bytes);
+    CHECK(p.ls_info.candidate_bytes == p.ls_info.candidate_bytes_paper);
+    CHECK(c.ls_info.candidate_bytes == c.ls_info.candidate_bytes_compact);
+  }
+}
+
+TEST_CASE("an over-budget Line Space is refused before it is built", "[line_space]") {
+  const Scene scene = single_mesh_scene(random_soup(5000, 2));
+  AccelOptions tight;
+  tight.ls.max_memory = 1 << 20;
+  const auto start = std::chrono::steady_clock::now();
+  REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:4:64"), tight), InputError);
+  REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:8:64")), InputError);  // ~256 nodes x 2 GB
+  CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 2.0);
+}
