@@ -1,0 +1,191 @@
+// Embree 3 as the correctness and performance peer (DESIGN §7).
+//
+// The scene is handed to Embree as world-space triangles, one triangle geometry per instance, attached
+// under the instance id (geomID = instance id, primID = triangle id), so Embree's ids are ours.  The
+// world positions are computed exactly as the flat BVH computes them (ls::transform_point), so the two
+// see bit-identical triangles.  RTC_SCENE_FLAG_ROBUST selects Embree's watertight intersector; both
+// faces are hit (the Debian build has no back-face culling; the constructor checks).
+//
+// Errors reported by Embree (its error callback and rtcGetDeviceError) become ls::InputError.  The
+// callback only records the message: throwing through Embree's C frames would be undefined.
+#include "embree_tracer.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <limits>
+#include <mutex>
+#include <string>
+
+namespace ls {
+
+struct EmbreeTracer::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  double build_seconds = 0.0;
+  std::atomic<int64_t> bytes{0};
+  std::mutex error_mutex;
+  std::string error;  // the first message the error callback reported, if any
+
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  static void on_error(void* user, RTCError code, const char* message) {
+    Impl* self = static_cast<Impl*>(user);
+    std::lock_guard<std::mutex> lock(self->error_mutex);
+    if (self->error.empty())
+      self->error = std::string(message ? message : "unknown error") + " (code " + std::to_string(int(code)) + ")";
+  }
+
+  static bool on_memory(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<Impl*>(user)->bytes.fetch_add(int64_t(bytes), std::memory_order_relaxed);
+    return true;  // never refuse an allocation
+  }
+
+  // Throws when Embree reported an error since the last check.
+  void check(const char* what) {
+    const RTCError code = rtcGetDeviceError(device);
+    std::string message;
+    {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      message.swap(error);
+    }
+    if (code == RTC_ERROR_NONE && message.empty()) return;
+    if (message.empty()) message = "error code " + std::to_string(int(code));
+    throw InputError(std::string("Embree: ") + what + ": " + message);
+  }
+};
+
+EmbreeTracer::EmbreeTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+  Impl& im = *impl_;
+  im.device = rtcNewDevice(nullptr);  // default configuration: all hardware threads through TBB
+  if (!im.device)
+    throw InputError("Embree: cannot create a device (error code " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+  rtcSetDeviceErrorFunction(im.device, &Impl::on_error, &im);
+  rtcSetDeviceMemoryMonitorFunction(im.device, &Impl::on_memory, &im);
+  if (rtcGetDeviceProperty(im.device, RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED) != 0)
+    throw InputError("Embree: this Embree library culls back faces; the peer needs both faces hit");
+  if (rtcGetDeviceProperty(im.device, RTC_DEVICE_PROPERTY_TRIANGLE_GEOMETRY_SUPPORTED) == 0)
+    throw InputError("Embree: this Embree library has no triangle geometry");
+
+  im.scene = rtcNewScene(im.device);
+  im.check("creating the scene");
+  rtcSetSceneFlags(im.scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_HIGH);
+
+  for (size_t id = 0; id < scene.instances.size(); ++id) {
+    const Instance& inst = scene.instances[id];
+    if (inst.mesh >= scene.meshes.size())
+      throw InputError("Embree: instance " + std::to_string(id) + " names a mesh that does not exist");
+    const Mesh& mesh = scene.meshes[inst.mesh];
+    if (mesh.triangles.empty() || mesh.positions.empty()) continue;  // nothing to hit: no geometry
+
+    RTCGeometry geom = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    im.check("creating a triangle geometry");
+    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
+    // Embree pads vertex buffers it allocates itself, so 16-byte loads of the last vertex are safe.
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), mesh.positions.size()));
+    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(uint32_t), mesh.triangles.size()));
+    if (!vertices || !indices) {
+      rtcReleaseGeometry(geom);
+      im.check("allocating geometry buffers");
+      throw InputError("Embree: cannot allocate geometry buffers");
+    }
+    const glm::mat4 m = inst.object_to_world;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.positions.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        const glm::vec3 p = transform_point(m, mesh.positions[i]);
+        vertices[3 * i + 0] = p.x;
+        vertices[3 * i + 1] = p.y;
+        vertices[3 * i + 2] = p.z;
+      }
+    });
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3 idx = mesh.triangles[t];
+      if (idx.x >= mesh.positions.size() || idx.y >= mesh.positions.size() || idx.z >= mesh.positions.size()) {
+        rtcReleaseGeometry(geom);
+        throw InputError("Embree: mesh '" + mesh.name + "' has a triangle index out of range");
+      }
+      indices[3 * t + 0] = idx.x;
+      indices[3 * t + 1] = idx.y;
+      indices[3 * t + 2] = idx.z;
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(im.scene, geom, unsigned(id));  // geomID = instance id
+    rtcReleaseGeometry(geom);                              // the scene holds its own reference
+    im.check("attaching a geometry");
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  rtcCommitScene(im.scene);
+  im.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  im.check("building the scene");
+}
+
+EmbreeTracer::~EmbreeTracer() = default;
+
+double EmbreeTracer::build_seconds() const { return impl_->build_seconds; }
+
+size_t EmbreeTracer::bytes() const {
+  const int64_t b = impl_->bytes.load(std::memory_order_relaxed);
+  return b > 0 ? size_t(b) : 0;
+}
+
+void EmbreeTracer::trace(const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit) const {
+  const RTCScene scene = impl_->scene;
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& range) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const lsk::Ray& ray = rays[i];
+      RTCRayHit rh;
+      rh.ray.org_x = ray.origin.x;
+      rh.ray.org_y = ray.origin.y;
+      rh.ray.org_z = ray.origin.z;
+      rh.ray.tnear = ray.tmin;
+      rh.ray.dir_x = ray.dir.x;
+      rh.ray.dir_y = ray.dir.y;
+      rh.ray.dir_z = ray.dir.z;
+      rh.ray.time = 0.0f;
+      rh.ray.tfar = ray.tmax;
+      rh.ray.mask = 0xFFFFFFFFu;
+      rh.ray.id = unsigned(i);
+      rh.ray.flags = 0;
+      lsk::Hit& h = hits[i];
+      h.instance = lsk::LS_INVALID;
+      h.triangle = lsk::LS_INVALID;
+      h.u = 0.0f;
+      h.v = 0.0f;
+      if (any_hit) {
+        rtcOccluded1(scene, &context, &rh.ray);
+        // Occluded: Embree sets tfar to -inf.  It names no triangle.
+        h.t = rh.ray.tfar == -inf ? ray.tmin : inf;
+        continue;
+      }
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(scene, &context, &rh);
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        h.t = inf;
+        continue;
+      }
+      h.t = rh.ray.tfar;
+      h.instance = rh.hit.geomID;
+      h.triangle = rh.hit.primID;
+      h.u = rh.hit.u;
+      h.v = rh.hit.v;
+    }
+  });
+}
+
+}  // namespace ls
