@@ -2,7 +2,6 @@
 find_package(Threads REQUIRED)           # before glslang: its targets use Threads::Threads
 find_package(TBB REQUIRED)
 find_package(glm REQUIRED)
-find_package(OpenMesh REQUIRED)
 find_package(TinyGLTF REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)

@@ -10,9 +10,12 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <filesystem>
+#include <new>
 #include <optional>
 
 namespace ls {
@@ -33,6 +36,7 @@ std::string first_line(const std::string& s) {
   if (b == std::string::npos) return "unknown error";
   std::string line = s.substr(b, s.find('\n', b) - b);
   while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+  if (line.size() > 200) line = line.substr(0, 200) + "...";  // tinygltf quotes whole data URIs
   return line;
 }
 
@@ -70,6 +74,9 @@ class GltfReader {
     read_nodes(scene);
     return scene;
   }
+
+  // Whether read() found a perspective camera; if not, the caller frames the validated scene.
+  bool has_camera() const { return has_camera_; }
 
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(path_ + ": " + what); }
@@ -272,6 +279,9 @@ class GltfReader {
       glm::dmat4 m;
       for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) m[c][r] = node.matrix[size_t(c * 4 + r)];  // column-major, as glTF
+      // Instances are affine: a projective bottom row would be silently ignored by every transform.
+      if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+        fail(where + ": matrix is not affine (bottom row must be 0 0 0 1)");
       return m;
     }
     glm::dmat4 t(1.0), r(1.0), s(1.0);
@@ -367,10 +377,6 @@ class GltfReader {
     }
   }
 
- public:
-  bool has_camera() const { return has_camera_; }
-
- private:
   enum : uint8_t { kUnseen, kOnPath, kDone };
   const tinygltf::Model& model_;
   const std::string& path_;
@@ -387,8 +393,15 @@ Scene load_gltf(const std::string& path) {
   loader.SetImageLoader(ignore_image, nullptr);
   tinygltf::Model model;
   std::string err, warn;
-  const bool ok = lower_ext(path) == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                                            : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  bool ok = false;
+  try {
+    ok = lower_ext(path) == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                                   : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {  // tinygltf 2.7 indexes with .at() on some malformed files
+    throw InputError(path + ": malformed glTF (" + e.what() + ")");
+  }
   // Warnings alone (an unreadable texture, say) do not matter: only colour factors are used.
   if (!ok) throw InputError(path + ": " + first_line(err.empty() ? warn : err));
 

@@ -16,7 +16,8 @@ Scene load_scene(const std::string& spec);
 // first perspective camera is the view (else a framing camera).
 Scene load_gltf(const std::string& path);
 
-// One OBJ/PLY/OFF/STL mesh through OpenMesh: a one-object scene with a framing camera and a
+// One OBJ/PLY/OFF/STL mesh, read by strict readers of our own (OpenMesh 9's readers crash or hang on
+// malformed files, and drop non-manifold faces, which would shift triangle ids): a one-object scene with a framing camera and a
 // default light (a white background that lights the mesh from every direction).
 Scene load_mesh_file(const std::string& path);
 
