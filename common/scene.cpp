@@ -33,6 +33,8 @@ void validate_scene(const Scene& scene) {
     if (mesh.materials.size() != mesh.triangles.size()) throw InputError(mname + ": one material per triangle expected");
     for (size_t i = 0; i < mesh.positions.size(); ++i)
       if (!finite(mesh.positions[i])) throw InputError(mname + ": vertex " + std::to_string(i) + " is NaN or infinite");
+    for (size_t i = 0; i < mesh.normals.size(); ++i)
+      if (!finite(mesh.normals[i])) throw InputError(mname + ": normal " + std::to_string(i) + " is NaN or infinite");
     for (const glm::uvec3& t : mesh.triangles)
       if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
         throw InputError(mname + ": triangle index out of range");
@@ -47,8 +49,11 @@ void validate_scene(const Scene& scene) {
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
         if (!std::isfinite(m[c][r])) throw InputError(where + ": instance " + std::to_string(i) + " has a NaN or infinite transform");
-    const float det = glm::determinant(glm::mat3(m));
-    if (!(std::fabs(det) > 0.0f) || !std::isfinite(det))
+    if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f)
+      throw InputError(where + ": instance " + std::to_string(i) + " has a projective (non-affine) transform");
+    // In double: a uniform scale of 1e-20 has a float determinant of 1e-60, which underflows.
+    const double det = glm::determinant(glm::dmat3(glm::mat3(m)));
+    if (!(std::fabs(det) > 0.0) || !std::isfinite(det))
       throw InputError(where + ": instance " + std::to_string(i) + " has a singular transform");
     tris += scene.meshes[inst.mesh].triangles.size();
   }
@@ -57,8 +62,13 @@ void validate_scene(const Scene& scene) {
   for (const Material& mat : scene.materials)
     if (!finite(mat.albedo) || !finite(mat.emission) || glm::any(glm::lessThan(mat.emission, glm::vec3(0.0f))))
       throw InputError(where + ": material '" + mat.name + "' has a NaN, infinite or negative colour");
-  if (!finite(world_bounds(scene).lo) || !finite(world_bounds(scene).hi))
-    throw InputError(where + ": transformed vertices overflow to infinity");
+  const Bounds bounds = world_bounds(scene);
+  if (!finite(bounds.lo) || !finite(bounds.hi)) throw InputError(where + ": transformed vertices overflow to infinity");
+  const Camera& cam = scene.camera;
+  if (!finite(cam.position) || !finite(cam.target) || !finite(cam.up) || !std::isfinite(cam.yfov))
+    throw InputError(where + ": the camera has a NaN or infinite parameter");
+  if (cam.position == cam.target) throw InputError(where + ": the camera looks at its own position");
+  if (!(cam.yfov > 0.0f && cam.yfov < 3.14159f)) throw InputError(where + ": the camera's field of view is not in (0, pi)");
 }
 
 Camera framing_camera(const Scene& scene) {

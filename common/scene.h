@@ -71,7 +71,8 @@ Bounds world_bounds(const Scene& scene);
 glm::vec3 transform_point(const glm::mat4& m, const glm::vec3& p);
 
 // Throws InputError when the scene cannot be traced correctly: no triangles, indices out of range,
-// NaN/Inf positions, singular transforms, materials out of range.
+// NaN/Inf positions or normals, singular or projective transforms, materials out of range, a camera
+// with NaN/Inf parameters, no view direction or a field of view outside (0, pi).
 void validate_scene(const Scene& scene);
 
 // A camera that frames the world bounds from the front (+z side), looking at the centre.

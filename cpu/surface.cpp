@@ -1,5 +1,7 @@
 #include "surface.h"
 
+#include "kernels/float_bits.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -34,7 +36,10 @@ SurfacePoint SurfaceLookup::at(const lsk::Hit& hit, const glm::vec3& ray_dir) co
   const float w0 = 1.0f - hit.u - hit.v;
   SurfacePoint sp;
   sp.position = a * w0 + b * hit.u + c * hit.v;
-  glm::vec3 ng = glm::cross(b - a, c - a);
+  // Edges scaled by a power of two first: at 1e20 or 1e-20 a float cross product over- or underflows.
+  glm::vec3 e1 = b - a, e2 = c - a;
+  const int k = lsk::unit_exponent(std::max(lsk::max_abs(e1), lsk::max_abs(e2)));
+  glm::vec3 ng = glm::cross(lsk::scale_pow2(e1, k), lsk::scale_pow2(e2, k));
   const float len = glm::length(ng);
   ng = len > 0.0f && std::isfinite(len) ? ng / len : -glm::normalize(ray_dir);
   if (glm::dot(ng, ray_dir) > 0.0f) ng = -ng;

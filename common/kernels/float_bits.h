@@ -21,14 +21,19 @@ LS_FN int unit_exponent(float m) {
   return clamp(-float_exponent(m), -126, 126);
 }
 
+// 2^e for e in [-126, 127], built from its bits (exact, and cheaper than ldexp).
+LS_FN float pow2(int e) { return intBitsToFloat((e + 127) << 23); }
+
 // x * 2^e, saturating to +-inf above the float range and flushing to 0 below it (GLSL leaves ldexp
-// undefined there); exact otherwise.
+// undefined there); exact otherwise.  Two multiplications by halves of e keep each factor in range,
+// and since both move x the same way the intermediate stays between x and the result.
 LS_FN float scale_pow2(float x, int e) {
   if (x == 0.0f || isinf(x) || isnan(x)) return x;
   int ex = float_exponent(x);
   if (ex + e > 127) return x < 0.0f ? -ls_infinity() : ls_infinity();
   if (ex + e < -126) return 0.0f * x;
-  return ldexp(x, e);
+  int e1 = e / 2;
+  return (x * pow2(e1)) * pow2(e - e1);
 }
 
 LS_FN vec3 scale_pow2(IN(vec3) v, int e) { return vec3(scale_pow2(v.x, e), scale_pow2(v.y, e), scale_pow2(v.z, e)); }

@@ -13,6 +13,7 @@
 
 #include "float_bits.h"
 #include "layouts.h"
+#include "ray_box.h"
 
 #ifdef __cplusplus
 namespace lsk {
@@ -39,10 +40,10 @@ LS_FN void ls_shaft_patches(uint shaft, uint n, OUT(uint) start_patch, OUT(uint)
 
 // The point at (i + su, j + sv) / N on a patch of the box [lo, hi]; inv_n = 1 / N, computed once by
 // the host so that no device divides.
-LS_FN vec3 ls_patch_point(IN(vec3) lo, IN(vec3) hi, uint patch, uint n, float inv_n, float su, float sv) {
+LS_FN vec3 ls_patch_point(IN(vec3) lo, IN(vec3) hi, uint patch_id, uint n, float inv_n, float su, float sv) {
   uint nn = n * n;
-  uint face = patch / nn;
-  uint rest = patch - face * nn;
+  uint face = patch_id / nn;
+  uint rest = patch_id - face * nn;
   uint j = rest / n;
   uint i = rest - j * n;
   uint a = face / 2u;
@@ -84,10 +85,11 @@ LS_FN uint ls_patch_of_point(IN(vec3) p, IN(vec3) lo, IN(vec3) scale, uint face,
 // line misses the box or enters and leaves through the same face (a line along a face): no shaft.
 LS_FN bool ls_line_shaft(IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, IN(vec3) lo, IN(vec3) hi, IN(vec3) scale,
                          uint n, OUT(uint) shaft, OUT(float) t_in, OUT(float) t_out) {
-  precise vec3 t0 = (lo - origin) * inv_dir;
-  precise vec3 t1 = (hi - origin) * inv_dir;
-  vec3 tn = min(t0, t1);
-  vec3 tf = max(t0, t1);
+  vec3 tn;
+  vec3 tf;
+  slab_interval(origin.x, inv_dir.x, lo.x, hi.x, tn.x, tf.x);
+  slab_interval(origin.y, inv_dir.y, lo.y, hi.y, tn.y, tf.y);
+  slab_interval(origin.z, inv_dir.z, lo.z, hi.z, tn.z, tf.z);
   uint in_axis = 0u;
   t_in = tn.x;
   if (tn.y > t_in) { in_axis = 1u; t_in = tn.y; }

@@ -70,7 +70,8 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   vec3 p0 = vec3(tri.v0);
   vec3 e1 = vec3(tri.v1) - p0;
   vec3 e2 = vec3(tri.v2) - p0;
-  vec3 n = cross(e1, e2);
+  int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
+  vec3 n = cross(scale_pow2(e1, ke), scale_pow2(e2, ke));
   float denom = dot(dir, n);
   if (denom == 0.0f || dot(n, n) == 0.0f) {
     ls_counters.refused_parallel += 1u;
@@ -84,8 +85,8 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
   vec3 q = origin + dir * t - p0;
   float nn = dot(n, n);
-  float b1 = dot(cross(q, e2), n) / nn;
-  float b2 = dot(cross(e1, q), n) / nn;
+  float b1 = dot(cross(scale_pow2(q, ke), scale_pow2(e2, ke)), n) / nn;
+  float b2 = dot(cross(scale_pow2(e1, ke), scale_pow2(q, ke)), n) / nn;
   float b0 = 1.0f - b1 - b2;
   uvec4 packed = tri_normals[prim];
   vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;

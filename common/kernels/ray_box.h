@@ -24,20 +24,40 @@ LS_FN vec3 safe_reciprocal(IN(vec3) d) {
   return vec3(safe_reciprocal1(d.x), safe_reciprocal1(d.y), safe_reciprocal1(d.z));
 }
 
-// t pushed outwards by 2*gamma(3) of its magnitude, the error bound of a slab distance.
+// t pushed outwards by a relative 2^-18 of its magnitude.  2*gamma(3) (about 3.6e-7) bounds the
+// error of a slab distance (Ize 2013); the larger slack also covers the triangle test's t, which can
+// err by tens of ulps, so that a box holding a hit tied with the current one is never pruned.
 LS_FN float widen_distance(float t) {
-  LS_CONST float two_gamma3 = 2.0f * (3.0f * 5.9604645e-8f) / (1.0f - 3.0f * 5.9604645e-8f);
-  precise float w = t + abs(t) * two_gamma3;
+  LS_CONST float slack = 3.81469727e-6f;  // 2^-18
+  precise float w = t + abs(t) * slack;
   return w;
+}
+
+// The distances at which the ray enters and leaves one slab [lo, hi] of a closed box.  A zero (or
+// denormal) direction component, marked by safe_reciprocal's huge value, means the ray runs parallel
+// to the slab: inside it (its planes included) for all t, or never.
+LS_FN void slab_interval(float origin, float inv_dir, float lo, float hi, OUT(float) t_enter, OUT(float) t_leave) {
+  LS_CONST float big = 3.0e38f;
+  if (abs(inv_dir) == big) {
+    bool inside = origin >= lo && origin <= hi;
+    t_enter = inside ? -big : big;
+    t_leave = inside ? big : -big;
+    return;
+  }
+  precise float t0 = (lo - origin) * inv_dir;
+  precise float t1 = (hi - origin) * inv_dir;
+  t_enter = min(t0, t1);
+  t_leave = max(t0, t1);
 }
 
 // True when [tmin, tmax] of the ray overlaps the box; tnear is the (conservative) entry distance,
 // used to order children.
 LS_FN bool ray_box(IN(vec3) origin, IN(vec3) inv_dir, float tmin, float tmax, IN(vec3) lo, IN(vec3) hi, OUT(float) tnear) {
-  precise vec3 t0 = (lo - origin) * inv_dir;
-  precise vec3 t1 = (hi - origin) * inv_dir;
-  vec3 tn = min(t0, t1);
-  vec3 tf = max(t0, t1);
+  vec3 tn;
+  vec3 tf;
+  slab_interval(origin.x, inv_dir.x, lo.x, hi.x, tn.x, tf.x);
+  slab_interval(origin.y, inv_dir.y, lo.y, hi.y, tn.y, tf.y);
+  slab_interval(origin.z, inv_dir.z, lo.z, hi.z, tn.z, tf.z);
   tnear = max(max(tn.x, tn.y), max(tn.z, tmin));
   float tfar = widen_distance(min(min(tf.x, tf.y), min(tf.z, tmax)));
   return tnear <= tfar;

@@ -1,13 +1,17 @@
-// Watertight, division-free ray/triangle test.
+// Watertight ray/triangle test (Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection",
+// JCGT 2013) with the triangle's distance taken from its plane.
 //
-// The vertices are translated to the ray's origin and scaled by one power of two (exact), then the
-// three edge functions e_i = dot(d, cross(p_j, p_k)) are taken.  Each is an expression of its edge's
-// two endpoints alone whose value flips sign exactly when the endpoints are swapped (products
-// commute, x - y = -(y - x) in IEEE arithmetic), so two triangles sharing an edge see exactly opposite
-// values: no ray slips between them, and a ray exactly on the edge (e = 0) hits both.  The hit/miss
-// and [tmin, tmax] decisions use only +, -, * (correctly rounded everywhere, DESIGN §5); the one
-// division computes t, u, v after the decision.  Both faces are hit.  A degenerate (zero-area)
-// triangle, or a ray in the triangle's plane, is never hit.
+// The vertices are translated to the ray's origin and scaled by one power of two (exact; keeps
+// products far from overflow at 1e20 and from underflow at 1e-20), then sheared so the ray runs along
+// +z.  The edge functions U, V, W are 2-d orientations of the sheared vertices, which depend on each
+// vertex and the ray alone, so neighbours sharing an edge or a vertex see the same numbers.  A
+// non-zero float orientation has the right sign (rounding is monotonic); a zero one is recomputed in
+// double, where the products of floats are exact, so every sign is exact and no ray slips through an
+// edge or a vertex.  Ties (a ray exactly on an edge) hit both triangles; traversal breaks them by id.
+//
+// t = dot(n, p0 - o) / dot(n, d) with n from the triangle's own edges: accurate however far the
+// triangle is.  The interval decision is made on that t, so the reported t always lies in
+// [tmin, tmax].  Both faces are hit; a degenerate triangle or a ray in its plane never is.
 #ifndef LS_RAY_TRIANGLE_H
 #define LS_RAY_TRIANGLE_H
 
@@ -18,12 +22,21 @@
 namespace lsk {
 #endif
 
-// A ray prepared for triangle tests: its direction scaled by 2^dir_exp into [1, 2).
+// A ray prepared for triangle tests: the direction scaled by 2^dir_exp into [1, 2), the axes that
+// make it +z, and the shear.
 struct TriRay {
   vec3 origin;
   int dir_exp;
   vec3 dir;
-  float pad;
+  uint kx;
+  uint ky;
+  uint kz;
+  float sx;
+  float sy;
+  float sz;
+  float pad0;
+  float pad1;
+  float pad2;
 };
 
 LS_FN TriRay make_tri_ray(IN(vec3) origin, IN(vec3) dir) {
@@ -31,7 +44,21 @@ LS_FN TriRay make_tri_ray(IN(vec3) origin, IN(vec3) dir) {
   r.origin = origin;
   r.dir_exp = unit_exponent(max_abs(dir));
   r.dir = scale_pow2(dir, r.dir_exp);
-  r.pad = 0.0f;
+  vec3 ad = abs(r.dir);
+  r.kz = ad.x >= ad.y ? (ad.x >= ad.z ? 0u : 2u) : (ad.y >= ad.z ? 1u : 2u);
+  r.kx = (r.kz + 1u) % 3u;
+  r.ky = (r.kx + 1u) % 3u;
+  if (r.dir[r.kz] < 0.0f) {  // keep the winding: swap the other two axes
+    uint k = r.kx;
+    r.kx = r.ky;
+    r.ky = k;
+  }
+  r.sx = r.dir[r.kx] / r.dir[r.kz];
+  r.sy = r.dir[r.ky] / r.dir[r.kz];
+  r.sz = 1.0f / r.dir[r.kz];
+  r.pad0 = 0.0f;
+  r.pad1 = 0.0f;
+  r.pad2 = 0.0f;
   return r;
 }
 
@@ -48,39 +75,42 @@ LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(ve
   a = scale_pow2(a, ks);
   b = scale_pow2(b, ks);
   c = scale_pow2(c, ks);
-  // Edge functions in Pluecker form: cross(b + c, c - b) = 2 cross(b, c), but its products are
-  // (distance x edge length) rather than (distance x distance), so the rounding error grows linearly,
-  // not quadratically, with distance / triangle size (Embree's robust intersector does the same).
-  // Swapping an edge's endpoints still negates the value exactly (b + c = c + b, c - b = -(b - c)):
-  // watertight as before.
-  precise float e0 = dot(r.dir, cross(b + c, c - b));
-  precise float e1 = dot(r.dir, cross(c + a, a - c));
-  precise float e2 = dot(r.dir, cross(a + b, b - a));
-  if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
-  precise float det = e0 + e1 + e2;
+  precise float ax = a[r.kx] - r.sx * a[r.kz];
+  precise float ay = a[r.ky] - r.sy * a[r.kz];
+  precise float bx = b[r.kx] - r.sx * b[r.kz];
+  precise float by = b[r.ky] - r.sy * b[r.kz];
+  precise float cx = c[r.kx] - r.sx * c[r.kz];
+  precise float cy = c[r.ky] - r.sy * c[r.kz];
+  precise float eu = cx * by - cy * bx;
+  precise float ev = ax * cy - ay * cx;
+  precise float ew = bx * ay - by * ax;
+  if (eu == 0.0f || ev == 0.0f || ew == 0.0f) {
+    precise double du = double(cx) * double(by) - double(cy) * double(bx);
+    precise double dv = double(ax) * double(cy) - double(ay) * double(cx);
+    precise double dw = double(bx) * double(ay) - double(by) * double(ax);
+    eu = float(du);
+    ev = float(dv);
+    ew = float(dw);
+  }
+  if ((eu < 0.0f || ev < 0.0f || ew < 0.0f) && (eu > 0.0f || ev > 0.0f || ew > 0.0f)) return false;
+  precise float det = eu + ev + ew;
   if (det == 0.0f) return false;
-  // t from the plane: n from the untranslated edges (exact to a few ulps of the edge), scaled by a
-  // power of two; t' = dot(n, a) / dot(n, dir).
+  // The plane: n from the untranslated edges, scaled by a power of two.
   precise vec3 f1 = p1 - p0;
   precise vec3 f2 = p2 - p0;
   int kf = unit_exponent(max(max_abs(f1), max_abs(f2)));
   f1 = scale_pow2(f1, kf);
   f2 = scale_pow2(f2, kf);
   precise vec3 n = cross(f1, f2);
-  precise float T = dot(n, a);
-  precise float D = dot(n, r.dir);
-  if (D == 0.0f) return false;
-  if (D < 0.0f) {
-    T = -T;
-    D = -D;
-  }
-  // t = t' * 2^(dir_exp - ks); compare T against the interval scaled the other way.
-  precise float lo = scale_pow2(tmin, ks - r.dir_exp) * D;
-  precise float hi = scale_pow2(tmax, ks - r.dir_exp) * D;
-  if (!(T >= lo && T <= hi)) return false;
-  t = clamp(scale_pow2(T / D, r.dir_exp - ks), tmin, tmax);
-  u = e1 / det;
-  v = e2 / det;
+  precise float tn = dot(n, a);
+  precise float td = dot(n, r.dir);
+  if (td == 0.0f) return false;
+  // dot(n, a) / dot(n, dir) is t scaled by 2^(ks - dir_exp); adding +0 turns -0 into +0.
+  precise float tt = scale_pow2(tn / td, r.dir_exp - ks) + 0.0f;
+  if (!(tt >= tmin && tt <= tmax)) return false;
+  t = tt;
+  u = ev / det;
+  v = ew / det;
   return true;
 }
 

@@ -18,8 +18,8 @@ LS_FN uint pcg_hash(uint v) {
 }
 
 // A uniform float in [0, 1) with 24 random bits.
-LS_FN float random01(uint seed, uint pixel, uint sample, uint bounce, uint dim) {
-  uint h = pcg_hash(seed ^ pcg_hash(pixel ^ pcg_hash(sample ^ pcg_hash(bounce * 256u + dim))));
+LS_FN float random01(uint seed, uint pixel, uint sample_index, uint bounce, uint dim) {
+  uint h = pcg_hash(seed ^ pcg_hash(pixel ^ pcg_hash(sample_index ^ pcg_hash(bounce * 256u + dim))));
   return float(h >> 8u) * (1.0f / 16777216.0f);
 }
 
