@@ -1,5 +1,7 @@
 // The Line Space against brute force and against the exact structures, at the extremes.
 #include "accel.h"
+#include "load_scene.h"
+#include "ray_generators.h"
 #include "kernels/line_space.h"
 
 #include <catch2/catch.hpp>
@@ -245,6 +247,18 @@ TEST_CASE("a refusal angle of 0 gives exactly the exact structure's hits", "[lin
     CHECK(counters.accepted == 0);
     CHECK(counters.empty == 0);
   }
+}
+
+TEST_CASE("a refusal angle of 0 gives exactly the exact hits on the built-in cornell scene", "[line_space]") {
+  const Scene scene = load_scene("builtin:cornell");
+  const Accel exact_flat = build_accel(scene, parse_structure("bvh"));
+  const Accel exact_2l = build_accel(scene, parse_structure("2l-bvh"));
+  const std::vector<lsk::Ray> rays = generate_rays(scene, exact_flat, RayKind::Diffuse, 20000, 5);
+  const auto flat = trace_all(exact_flat, rays), two = trace_all(exact_2l, rays);
+  REQUIRE(same_bits(flat, trace_all(build_accel(scene, parse_structure("f-ls:6:6"), angle(0.0f)), rays)));
+  REQUIRE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4"), angle(0.0f)), rays)));
+  // With the default angle the approximations do change some hits: the test above can fail.
+  CHECK_FALSE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4")), rays)));
 }
 
 TEST_CASE("on one large planar mesh every accepted approximation lands on the plane", "[line_space]") {
