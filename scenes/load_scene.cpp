@@ -40,8 +40,7 @@ Scene load_scene(const std::string& spec) {
     if (!fs::is_regular_file(st)) throw InputError(spec + ": not a regular file");
     scene = gltf ? load_gltf(spec) : load_mesh_file(spec);
   }
-  scene.name = spec;
-  validate_scene(scene);
+  scene.name = spec;  // every loader has already validated the scene it returns
   return scene;
 }
 

@@ -1,5 +1,6 @@
 // Scene loading: a path (.gltf .glb .obj .ply .off .stl) or `builtin:NAME`.  Throws ls::InputError
-// with a one-line reason on anything it cannot load; every returned scene has passed validate_scene().
+// with a one-line reason on anything it cannot load; each loader below returns only scenes that have
+// passed validate_scene().
 #pragma once
 
 #include "scene.h"
