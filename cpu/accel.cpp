@@ -196,7 +196,8 @@ void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from) {
   into.empty += from.empty;
   into.accepted += from.accepted;
   into.refused_angle += from.refused_angle;
-  into.refused_interval += from.refused_interval;
+  into.refused_behind += from.refused_behind;
+  into.refused_beyond += from.refused_beyond;
   into.refused_parallel += from.refused_parallel;
   into.refused_no_shaft += from.refused_no_shaft;
 }

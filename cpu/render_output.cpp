@@ -26,7 +26,8 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
                           {"ls_empty", b.ls.empty},
                           {"ls_accepted", b.ls.accepted},
                           {"ls_refused_angle", b.ls.refused_angle},
-                          {"ls_refused_interval", b.ls.refused_interval},
+                          {"ls_refused_behind", b.ls.refused_behind},
+                          {"ls_refused_beyond", b.ls.refused_beyond},
                           {"ls_refused_parallel", b.ls.refused_parallel},
                           {"ls_refused_no_shaft", b.ls.refused_no_shaft},
                           {"mrays_per_s", b.trace_seconds > 0.0 ? double(rays) / b.trace_seconds * 1e-6 : 0.0}});

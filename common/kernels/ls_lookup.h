@@ -78,8 +78,12 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
     return LS_FALLBACK;
   }
   float t = dot(p0 - origin, n) / denom;
-  if (!(t >= tmin && t <= hit.t)) {
-    ls_counters.refused_interval += 1u;
+  if (!(t >= tmin)) {
+    ls_counters.refused_behind += 1u;
+    return LS_FALLBACK;
+  }
+  if (!(t <= hit.t)) {
+    ls_counters.refused_beyond += 1u;
     return LS_FALLBACK;
   }
   // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
