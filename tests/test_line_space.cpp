@@ -326,6 +326,38 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
   CHECK(build_accel(soup, parse_structure("f-ls:0:2"), big_only).ls_info.ls_nodes == 0);
 }
 
+TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes included", "[line_space]") {
+  // Origins inside the soup's LS boxes: a candidate behind the origin must be refused, never reported.
+  const Scene scene = single_mesh_scene(random_soup(3000, 17));
+  std::mt19937 rng(23);
+  std::vector<lsk::Ray> rays = random_rays(20000, 29, glm::vec3(0.0f), glm::vec3(1.0f));
+  for (lsk::Ray& r : rays) {
+    r.tmin = 0.05f * uniform(rng);
+    r.tmax = r.tmin + 0.5f * uniform(rng);
+  }
+  for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
+    const Accel a = build_accel(scene, parse_structure(name), angle(89.0f));
+    lsk::LsCounters counters{};
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters);
+    INFO(name);
+    CHECK(counters.refused_behind > 0);
+    CHECK(counters.refused_beyond > 0);
+    CHECK(counters.accepted > 0);
+    size_t hit_count = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      if (hits[i].triangle == lsk::LS_INVALID) continue;
+      ++hit_count;
+      REQUIRE(hits[i].t >= rays[i].tmin);
+      REQUIRE(hits[i].t <= rays[i].tmax);
+    }
+    CHECK(hit_count > 0);
+    // Any-hit answers stay inside the interval too.
+    const std::vector<lsk::Hit> any = trace_all(a, rays, true);
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (any[i].triangle != lsk::LS_INVALID) REQUIRE((any[i].t >= rays[i].tmin && any[i].t <= rays[i].tmax));
+  }
+}
+
 TEST_CASE("2L-LS stores one Line Space per unique mesh however many instances use it", "[line_space]") {
   std::vector<glm::mat4> many;
   for (int i = 0; i < 64; ++i)
