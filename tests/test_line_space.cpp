@@ -92,8 +92,15 @@ bool same_bits(const std::vector<lsk::Hit>& a, const std::vector<lsk::Hit>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0;
 }
 
-AccelOptions angle(float degrees) {
+// The paper's behaviour: every node at depth D gets a Line Space, however small its subtree.
+AccelOptions paper() {
   AccelOptions o;
+  o.ls.min_triangles = 0;
+  return o;
+}
+
+AccelOptions angle(float degrees) {
+  AccelOptions o = paper();
   o.ls.angle_degrees = degrees;
   return o;
 }
@@ -187,7 +194,7 @@ TEST_CASE("every stored candidate equals a brute-force search over its subtree",
     for (int n : {1, 2, 3}) {
       const Scene scene = single_mesh_scene(random_soup(300, 7 + uint32_t(n)));
       StructureSpec spec = parse_structure(std::string(two_level ? "2l-ls:" : "f-ls:") + "2:" + std::to_string(n));
-      AccelOptions opt;
+      AccelOptions opt = paper();
       opt.ls.further_rays = 4;
       const Accel a = build_accel(scene, spec, opt);
       REQUIRE(a.ls_info.ls_nodes > 0);
@@ -236,7 +243,7 @@ TEST_CASE("a refusal angle of 0 gives exactly the exact structure's hits", "[lin
   for (const char* pair : {"bvh f-ls:4:3", "bvh f-ls:0:6", "2l-bvh 2l-ls:2:4", "2l-bvh 2l-ls:0:1"}) {
     const std::string p(pair);
     const std::string exact_name = p.substr(0, p.find(' ')), ls_name = p.substr(p.find(' ') + 1);
-    const Accel exact = build_accel(scene, parse_structure(exact_name));
+    const Accel exact = build_accel(scene, parse_structure(exact_name), paper());
     const Accel approx = build_accel(scene, parse_structure(ls_name), angle(0.0f));
     REQUIRE(approx.ls_info.ls_nodes > 0);
     INFO(ls_name);
@@ -251,14 +258,14 @@ TEST_CASE("a refusal angle of 0 gives exactly the exact structure's hits", "[lin
 
 TEST_CASE("a refusal angle of 0 gives exactly the exact hits on the built-in cornell scene", "[line_space]") {
   const Scene scene = load_scene("builtin:cornell");
-  const Accel exact_flat = build_accel(scene, parse_structure("bvh"));
-  const Accel exact_2l = build_accel(scene, parse_structure("2l-bvh"));
+  const Accel exact_flat = build_accel(scene, parse_structure("bvh"), paper());
+  const Accel exact_2l = build_accel(scene, parse_structure("2l-bvh"), paper());
   const std::vector<lsk::Ray> rays = generate_rays(scene, exact_flat, RayKind::Diffuse, 20000, 5);
   const auto flat = trace_all(exact_flat, rays), two = trace_all(exact_2l, rays);
   REQUIRE(same_bits(flat, trace_all(build_accel(scene, parse_structure("f-ls:6:6"), angle(0.0f)), rays)));
   REQUIRE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4"), angle(0.0f)), rays)));
   // With the default angle the approximations do change some hits: the test above can fail.
-  CHECK_FALSE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4")), rays)));
+  CHECK_FALSE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4"), paper()), rays)));
 }
 
 TEST_CASE("on one large planar mesh every accepted approximation lands on the plane", "[line_space]") {
@@ -302,7 +309,7 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
   }
   for (const char* name : {"f-ls:0:1", "f-ls:0:6", "2l-ls:0:3", "2l-ls:0:2"}) {
     const Accel a = build_accel(flat, parse_structure(name), angle(89.0f));
-    const Accel exact = build_accel(flat, parse_structure("bvh"));
+    const Accel exact = build_accel(flat, parse_structure("bvh"), paper());
     INFO(name);
     REQUIRE(a.ls_info.ls_nodes > 0);
     const auto got = trace_all(a, down), want = trace_all(exact, down);
@@ -313,17 +320,22 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
   }
   // Depth past the leaves: no LS node at all, and the exact structure's answers.
   const Scene soup = single_mesh_scene(random_soup(500, 9));
-  const Accel deep = build_accel(soup, parse_structure("f-ls:40:2"));
+  const Accel deep = build_accel(soup, parse_structure("f-ls:40:2"), paper());
   REQUIRE(deep.ls_info.ls_nodes == 0);
   const std::vector<lsk::Ray> rays = random_rays(5000, 4);
-  REQUIRE(same_bits(trace_all(deep, rays), trace_all(build_accel(soup, parse_structure("bvh")), rays)));
+  REQUIRE(same_bits(trace_all(deep, rays), trace_all(build_accel(soup, parse_structure("bvh"), paper()), rays)));
   // D = 0: exactly one LS node per BVH (F) or per unique object (2L).
-  CHECK(build_accel(soup, parse_structure("f-ls:0:2")).ls_info.ls_nodes == 1);
-  CHECK(build_accel(soup, parse_structure("2l-ls:0:2")).ls_info.ls_nodes == 1);
+  CHECK(build_accel(soup, parse_structure("f-ls:0:2"), paper()).ls_info.ls_nodes == 1);
+  CHECK(build_accel(soup, parse_structure("2l-ls:0:2"), paper()).ls_info.ls_nodes == 1);
   // The minimum subtree size skips small nodes.
-  AccelOptions big_only;
+  AccelOptions big_only = paper();
   big_only.ls.min_triangles = 1000;
   CHECK(build_accel(soup, parse_structure("f-ls:0:2"), big_only).ls_info.ls_nodes == 0);
+  // The default skips subtrees of fewer than 8 triangles (measured: README); the paper's 0 keeps them.
+  const Accel deep_default = build_accel(soup, parse_structure("f-ls:7:2"));
+  const Accel deep_paper = build_accel(soup, parse_structure("f-ls:7:2"), paper());
+  REQUIRE(deep_paper.ls_info.ls_nodes > deep_default.ls_info.ls_nodes);
+  for (const lsk::LsNode& ls : deep_default.ls_nodes) REQUIRE(ls.range_count >= 8u);
 }
 
 TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes included", "[line_space]") {
@@ -365,20 +377,20 @@ TEST_CASE("2L-LS stores one Line Space per unique mesh however many instances us
                                0.1f * float(i), glm::vec3(0, 1, 0)));
   const Mesh mesh = random_soup(400, 21);
   const Scene one = single_mesh_scene(mesh), sixty_four = single_mesh_scene(mesh, many);
-  const Accel a1 = build_accel(one, parse_structure("2l-ls:2:3")), a64 = build_accel(sixty_four, parse_structure("2l-ls:2:3"));
+  const Accel a1 = build_accel(one, parse_structure("2l-ls:2:3"), paper()), a64 = build_accel(sixty_four, parse_structure("2l-ls:2:3"), paper());
   CHECK(a64.ls_info.ls_nodes == a1.ls_info.ls_nodes);
   CHECK(a64.ls_candidates == a1.ls_candidates);
   CHECK(a64.bytes_ls() == a1.bytes_ls());
   // The flat LS grows with the instances.
-  CHECK(build_accel(sixty_four, parse_structure("f-ls:6:3")).ls_info.ls_nodes > a1.ls_info.ls_nodes);
+  CHECK(build_accel(sixty_four, parse_structure("f-ls:6:3"), paper()).ls_info.ls_nodes > a1.ls_info.ls_nodes);
 }
 
 TEST_CASE("compact and paper candidates give identical hits and compact is smaller", "[line_space]") {
   const Scene scene = single_mesh_scene(random_soup(3000, 13));
-  AccelOptions paper;
-  paper.ls.paper_candidates = true;
+  AccelOptions paper_mode = paper();
+  paper_mode.ls.paper_candidates = true;
   for (const char* name : {"f-ls:3:4", "2l-ls:1:3"}) {
-    const Accel c = build_accel(scene, parse_structure(name)), p = build_accel(scene, parse_structure(name), paper);
+    const Accel c = build_accel(scene, parse_structure(name), paper()), p = build_accel(scene, parse_structure(name), paper_mode);
     const std::vector<lsk::Ray> rays = random_rays(10000, 8);
     REQUIRE(same_bits(trace_all(c, rays), trace_all(p, rays)));
     CHECK(c.ls_info.candidate_bytes < p.ls_info.candidate_bytes);
@@ -389,10 +401,10 @@ TEST_CASE("compact and paper candidates give identical hits and compact is small
 
 TEST_CASE("an over-budget Line Space is refused before it is built", "[line_space]") {
   const Scene scene = single_mesh_scene(random_soup(5000, 2));
-  AccelOptions tight;
+  AccelOptions tight = paper();
   tight.ls.max_memory = 1 << 20;
   const auto start = std::chrono::steady_clock::now();
   REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:4:64"), tight), InputError);
-  REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:8:64")), InputError);  // ~256 nodes x 2 GB
+  REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:8:64"), paper()), InputError);  // ~256 nodes x 2 GB
   CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 2.0);
 }
