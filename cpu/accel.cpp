@@ -34,6 +34,13 @@ Bounds transformed_bounds(const glm::mat4& m, const glm::vec3& lo, const glm::ve
   return box;
 }
 
+// Which meshes some instance uses: the structures hold only those.
+std::vector<bool> used_meshes(const Scene& scene) {
+  std::vector<bool> used(scene.meshes.size(), false);
+  for (const Instance& inst : scene.instances) used[inst.mesh] = true;
+  return used;
+}
+
 void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel) {
   // World-space triangles, instance by instance in id order.
   std::vector<size_t> first(scene.instances.size() + 1, 0);
@@ -67,14 +74,12 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
     accel.tri_ids[k] = uint32_t(src - first[inst]);
     accel.tri_instances[k] = uint32_t(inst);
   });
-  std::vector<bool> used(scene.meshes.size(), false);
-  for (const Instance& inst : scene.instances) used[inst.mesh] = true;
+  const std::vector<bool> used = used_meshes(scene);
   accel.objects = size_t(std::count(used.begin(), used.end(), true));
 }
 
 void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& accel) {
-  std::vector<bool> used(scene.meshes.size(), false);
-  for (const Instance& inst : scene.instances) used[inst.mesh] = true;
+  const std::vector<bool> used = used_meshes(scene);
 
   // One BVH per unique mesh, in object space, built in parallel.
   std::vector<BvhBuildResult> object_bvh(scene.meshes.size());

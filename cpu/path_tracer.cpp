@@ -164,16 +164,24 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       BounceStats& stats = result.bounces[size_t(k)];
       std::vector<glm::vec3>& image = result.bounce_images[size_t(k)];
 
+      // Gathers the rays of the selected pixels into one batch and traces it, timed; `active` lists
+      // the pixels in batch order.
+      auto trace_selected = [&](auto selected, auto ray_of, bool any_hit) {
+        active.clear();
+        for (uint32_t p = 0; p < pixels; ++p)
+          if (selected(p)) active.push_back(p);
+        batch.resize(active.size());
+        batch_hits.resize(active.size());
+        for (size_t i = 0; i < active.size(); ++i) batch[i] = ray_of(active[i]);
+        stats.trace_seconds +=
+            timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), any_hit, &stats.ls); });
+        return uint64_t(active.size());
+      };
+
       // Trace the extension rays of this bounce (the camera rays at bounce 0).
-      active.clear();
-      for (uint32_t p = 0; p < pixels; ++p)
-        if (paths[p].alive) active.push_back(p);
+      stats.extension_rays += trace_selected([&](uint32_t p) { return paths[p].alive; },
+                                             [&](uint32_t p) { return paths[p].ray; }, false);
       if (active.empty()) break;
-      batch.resize(active.size());
-      batch_hits.resize(active.size());
-      for (size_t i = 0; i < active.size(); ++i) batch[i] = paths[active[i]].ray;
-      stats.trace_seconds += timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), false, &stats.ls); });
-      stats.extension_rays += active.size();
 
       // Shade: emission found, a light sample for next-event estimation, the next direction.
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
@@ -254,14 +262,8 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       });
 
       // Trace this bounce's shadow rays (any hit) and add the light they let through.
-      active.clear();
-      for (uint32_t p = 0; p < pixels; ++p)
-        if (has_shadow[p]) active.push_back(p);
-      batch.resize(active.size());
-      batch_hits.resize(active.size());
-      for (size_t i = 0; i < active.size(); ++i) batch[i] = shadows[active[i]].ray;
-      stats.trace_seconds += timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), true, &stats.ls); });
-      stats.shadow_rays += active.size();
+      stats.shadow_rays += trace_selected([&](uint32_t p) { return has_shadow[p] != 0; },
+                                          [&](uint32_t p) { return shadows[p].ray; }, true);
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
         const ShadowQuery& sq = shadows[active[i]];

@@ -14,7 +14,7 @@ struct RenderReportContext {
   std::string schedule;
   int spp = 0;
   uint32_t seed = 0;
-  std::map<std::string, Accel>* structures = nullptr;
+  const std::map<std::string, Accel>* structures = nullptr;
 };
 
 nlohmann::json render_report(const RenderResult& result, const RenderReportContext& context);
