@@ -182,7 +182,10 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
     build_two_level(scene, options.bvh, accel);
   else
     build_flat(scene, options.bvh, accel);
-  if (spec.line_space()) build_line_space(scene, options.ls, accel);
+  if (spec.line_space()) {
+    if (options.search_candidates) build_line_space(scene, options.ls, accel);
+    else layout_line_space(scene, options.ls, accel);
+  }
   accel.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return accel;
 }

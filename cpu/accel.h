@@ -46,6 +46,7 @@ struct Accel {
 struct AccelOptions {
   BvhBuildOptions bvh;
   LsOptions ls;
+  bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
   AccelOptions() = default;
   AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
 };

@@ -97,8 +97,7 @@ size_t estimate_line_space_bytes(size_t ls_nodes, int n) {
   return size_t(double(ls_nodes) * (shafts * 4.0 + double(sizeof(lsk::LsNode))));
 }
 
-void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
-  const auto start = std::chrono::steady_clock::now();
+void layout_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
   const int depth = accel.spec.depth;
   const uint32_t n = uint32_t(accel.spec.subdivision);
   const uint32_t shafts = lsk::ls_shaft_count(n);
@@ -157,46 +156,63 @@ void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel
   accel.ls_candidates.assign(words, 0xFFFFFFFFu);  // all ones: every shaft empty until found
   compute_triangle_normals(scene, range, accel);
 
-  // The candidate search, every shaft of every LS node, in parallel.
-  lsk::TraceContext context = accel.context();
-  context.ls_enabled = 0;
-  const float inv_n = 1.0f / float(n);
-  const uint32_t instance = accel.spec.two_level() ? 0u : lsk::LS_INVALID;
-  std::atomic<size_t> empty{0};
-  tbb::parallel_for(size_t(0), accel.ls_nodes.size(), [&](size_t li) {
-    const lsk::LsNode ls = accel.ls_nodes[li];
-    std::vector<uint32_t> local(shafts);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
-      lsk::TraceContext c = context;
-      for (uint32_t s = r.begin(); s != r.end(); ++s) {
-        const uint32_t prim = c.ls_find_candidate(ls.node, ls, s, n, inv_n, uint32_t(options.further_rays), instance);
-        local[s] = prim == lsk::LS_INVALID ? lsk::LS_INVALID : prim - ls.range_first;
-      }
-    });
-    size_t node_empty = 0;
-    uint32_t* out = accel.ls_candidates.data() + ls.candidates;
-    const uint32_t bits = ls.bytes * 8, per_word = 4 / ls.bytes;
-    const uint32_t mask = bits == 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
-    for (uint32_t s = 0; s < shafts; ++s) {
-      const uint32_t v = local[s] == lsk::LS_INVALID ? mask : local[s];
-      node_empty += local[s] == lsk::LS_INVALID;
-      uint32_t& w = out[s / per_word];
-      const uint32_t shift = (s % per_word) * bits;
-      w = (w & ~(mask << shift)) | ((v & mask) << shift);
-    }
-    empty += node_empty;
-  });
-
   LsBuildInfo& info = accel.ls_info;
+  info = LsBuildInfo{};
   info.ls_nodes = accel.ls_nodes.size();
   info.shafts_per_ls = shafts;
-  info.empty_shafts = empty.load();
+  info.empty_shafts = info.ls_nodes * size_t(shafts);
   info.candidate_bytes = size_t(words) * 4;
   info.candidate_bytes_paper = info.ls_nodes * size_t(shafts) * 4;
   info.candidate_bytes_compact = 0;
   for (const lsk::LsNode& ls : accel.ls_nodes)
     info.candidate_bytes_compact += (uint64_t(shafts) * candidate_bytes(ls.range_count, false) + 3) / 4 * 4;
-  info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
+
+size_t pack_ls_candidates(Accel& accel, size_t ls_index, const uint32_t* prims) {
+  const lsk::LsNode& ls = accel.ls_nodes[ls_index];
+  const uint32_t shafts = uint32_t(accel.ls_info.shafts_per_ls);
+  size_t empty = 0;
+  uint32_t* out = accel.ls_candidates.data() + ls.candidates;
+  const uint32_t bits = ls.bytes * 8, per_word = 4 / ls.bytes;
+  const uint32_t mask = bits == 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
+  for (uint32_t s = 0; s < shafts; ++s) {
+    const bool none = prims[s] == lsk::LS_INVALID;
+    const uint32_t v = none ? mask : prims[s] - ls.range_first;  // local to the node's triangle range
+    empty += none;
+    uint32_t& w = out[s / per_word];
+    const uint32_t shift = (s % per_word) * bits;
+    w = (w & ~(mask << shift)) | ((v & mask) << shift);
+  }
+  return empty;
+}
+
+void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
+  const auto start = std::chrono::steady_clock::now();
+  layout_line_space(scene, options, accel);
+  const uint32_t n = uint32_t(accel.spec.subdivision);
+  const uint32_t shafts = uint32_t(accel.ls_info.shafts_per_ls);
+
+  // The candidate search, every shaft of every LS node, in parallel.
+  lsk::TraceContext context = accel.context();
+  context.ls_enabled = 0;
+  const float inv_n = 1.0f / float(n);
+  const uint32_t instance = ls_search_instance(accel);
+  std::atomic<size_t> empty{0};
+  tbb::parallel_for(size_t(0), accel.ls_nodes.size(), [&](size_t li) {
+    const lsk::LsNode ls = accel.ls_nodes[li];
+    std::vector<uint32_t> prims(shafts);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
+      lsk::TraceContext c = context;
+      for (uint32_t s = r.begin(); s != r.end(); ++s)
+        prims[s] = c.ls_find_candidate(ls.node, ls, s, n, inv_n, uint32_t(options.further_rays), instance);
+    });
+    empty += pack_ls_candidates(accel, li, prims.data());  // nodes own disjoint words
+  });
+
+  accel.ls_info.empty_shafts = empty.load();
+  accel.ls_info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+uint32_t ls_search_instance(const Accel& accel) { return accel.spec.two_level() ? 0u : lsk::LS_INVALID; }
 
 }  // namespace ls

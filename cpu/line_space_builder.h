@@ -34,9 +34,23 @@ struct LsBuildInfo {
   double seconds = 0.0;
 };
 
-// Adds the Line Space to an exact structure that build_accel() made.  Throws InputError when the
+// Adds the Line Space to an exact structure that build_accel() made: layout_line_space(), then the
+// candidate search on all CPU threads, packed by pack_ls_candidates().  Throws InputError when the
 // estimated memory exceeds the budget, before allocating anything large.
 void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel);
+
+// The part of the build both back ends share: chooses the LS nodes (boxes, subtree ranges, bytes per
+// candidate, word offsets), allocates accel.ls_candidates with every shaft empty, computes the vertex
+// normals and fills accel.ls_info (sizes; empty_shafts = every shaft until a search packs its result).
+void layout_line_space(const Scene& scene, const LsOptions& options, Accel& accel);
+
+// The one packing rule: the search result of every shaft of LS node `ls_index` (an index into tris[],
+// or LS_INVALID when empty) stored as an index local to the node's triangle range in ls.bytes bytes,
+// all ones = empty.  Returns the number of empty shafts.  Distinct nodes may be packed concurrently.
+size_t pack_ls_candidates(Accel& accel, size_t ls_index, const uint32_t* prims);
+
+// The `instance` argument of ls_find_candidate() for this structure (0 for 2L, LS_INVALID for F).
+uint32_t ls_search_instance(const Accel& accel);
 
 // Bytes the Line Space of `ls_nodes` nodes at subdivision n would take (candidates at 4 bytes).
 size_t estimate_line_space_bytes(size_t ls_nodes, int n);

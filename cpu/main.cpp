@@ -2,6 +2,7 @@
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
 #include "accel.h"
 #include "bench.h"
+#include "cli_shared.h"
 #include "load_scene.h"
 #include "path_tracer.h"
 #include "ray_files.h"
@@ -18,62 +19,6 @@
 namespace {
 
 using namespace ls;
-
-struct Size {
-  uint32_t width = 512, height = 512;
-};
-
-Size parse_size(const std::string& text) {
-  const size_t x = text.find('x');
-  Size s;
-  try {
-    size_t used_w = 0, used_h = 0;
-    if (x == std::string::npos) throw std::invalid_argument("x");
-    const long w = std::stol(text.substr(0, x), &used_w);
-    const long h = std::stol(text.substr(x + 1), &used_h);
-    if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("trailing");
-    if (w < 1 || h < 1 || w > 16384 || h > 16384) throw InputError("--size " + text + ": width and height must be in [1, 16384]");
-    s.width = uint32_t(w);
-    s.height = uint32_t(h);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception&) {
-    throw InputError("--size '" + text + "' is not WIDTHxHEIGHT (e.g. 512x512)");
-  }
-  return s;
-}
-
-void print_build(const Accel& a, bool json) {
-  if (json) {
-    nlohmann::json j{{"structure", a.spec.name()},
-                     {"triangles", a.world_triangles},
-                     {"objects", a.objects},
-                     {"instances", a.instance_count},
-                     {"nodes", a.nodes.size() + a.top_nodes.size()},
-                     {"max_depth", a.max_depth},
-                     {"ls_nodes", a.ls_info.ls_nodes},
-                     {"shafts_per_ls", a.ls_info.shafts_per_ls},
-                     {"empty_shafts", a.ls_info.empty_shafts},
-                     {"bytes_total", a.bytes_total()},
-                     {"bytes_ls", a.bytes_ls()},
-                     {"bytes_ls_candidates", a.ls_info.candidate_bytes},
-                     {"bytes_ls_candidates_paper", a.ls_info.candidate_bytes_paper},
-                     {"bytes_ls_candidates_compact", a.ls_info.candidate_bytes_compact},
-                     {"ls_build_seconds", a.ls_info.seconds},
-                     {"ls_shafts_per_second", a.ls_info.seconds > 0.0 ? double(a.ls_info.ls_nodes * a.ls_info.shafts_per_ls) / a.ls_info.seconds : 0.0},
-                     {"build_seconds", a.build_seconds}};
-    std::cout << j.dump(2) << "\n";
-    return;
-  }
-  std::printf("structure      %s\ntriangles      %zu\nobjects        %zu\ninstances      %zu\nnodes          %zu\n"
-              "max_depth      %d\nls_nodes       %zu\nshafts_per_ls  %zu\nempty_shafts   %zu\n"
-              "bytes_total    %zu (%.2f MB)\nbytes_ls       %zu (%.2f MB; candidates %.2f MB, paper mode %.2f MB)\n"
-              "build_seconds  %.3f (Line Space %.3f)\n",
-              a.spec.name().c_str(), a.world_triangles, a.objects, a.instance_count, a.nodes.size() + a.top_nodes.size(),
-              a.max_depth, a.ls_info.ls_nodes, a.ls_info.shafts_per_ls, a.ls_info.empty_shafts, a.bytes_total(),
-              double(a.bytes_total()) / 1e6, a.bytes_ls(), double(a.bytes_ls()) / 1e6, double(a.ls_info.candidate_bytes) / 1e6,
-              double(a.ls_info.candidate_bytes_paper) / 1e6, a.build_seconds, a.ls_info.seconds);
-}
 
 void print_bench(const BenchResult& r, bool json) {
   if (json) {
@@ -95,46 +40,6 @@ void print_bench(const BenchResult& r, bool json) {
   for (const BenchEntry& e : r.results)
     std::printf("%-14s %12.2f %9.2fx %12.2f %10.3f\n", e.structure.c_str(), e.mrays_per_s, e.ratio_vs_embree,
                 double(e.bytes) / 1e6, e.build_seconds);
-}
-
-// Line Space options shared by every subcommand that builds a structure.
-struct LsFlags {
-  double angle = LsOptions{}.angle_degrees;
-  int further_rays = LsOptions{}.further_rays;
-  uint32_t min_triangles = LsOptions{}.min_triangles;
-  std::string candidates = "compact";
-  double max_memory_mb = 0.0;
-
-  void add_to(CLI::App* app) {
-    app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
-        ->capture_default_str()->check(CLI::Range(0.0, 90.0));
-    app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
-        ->capture_default_str()->check(CLI::Range(0, 1024));
-    app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
-        ->capture_default_str();
-    app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
-        ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
-    app->add_option("--max-memory", max_memory_mb, "refuse a Line Space estimated above this many MB (0: half of RAM)")
-        ->check(CLI::Range(0.0, 1e9));
-  }
-  AccelOptions options() const {
-    AccelOptions o;
-    o.ls.angle_degrees = float(angle);
-    o.ls.further_rays = further_rays;
-    o.ls.min_triangles = min_triangles;
-    o.ls.paper_candidates = candidates == "paper";
-    o.ls.max_memory = size_t(max_memory_mb * 1e6);
-    return o;
-  }
-};
-
-void print_counters(const lsk::LsCounters& c) {
-  std::fprintf(stderr,
-               "line space: %u lookups, %u empty shafts, %u accepted, refused %u (angle %u, behind the origin %u, "
-               "beyond the current t %u, parallel %u, no shaft %u)\n",
-               c.lookups, c.empty, c.accepted,
-               c.refused_angle + c.refused_behind + c.refused_beyond + c.refused_parallel + c.refused_no_shaft,
-               c.refused_angle, c.refused_behind, c.refused_beyond, c.refused_parallel, c.refused_no_shaft);
 }
 
 }  // namespace

@@ -115,7 +115,8 @@ std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const
 }
 
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
-                    const Progress& progress) {
+                    const Progress& progress, const BatchTracer& tracer) {
+  const BatchTracer trace_batch = tracer ? tracer : BatchTracer(trace_rays);
   const auto start = std::chrono::steady_clock::now();
   const uint32_t pixels = options.width * options.height;
   const int bounces = options.bounces;
@@ -174,7 +175,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
         batch_hits.resize(active.size());
         for (size_t i = 0; i < active.size(); ++i) batch[i] = ray_of(active[i]);
         stats.trace_seconds +=
-            timed([&] { trace_rays(structure, batch.data(), batch_hits.data(), batch.size(), any_hit, &stats.ls); });
+            timed([&] { trace_batch(structure, batch.data(), batch_hits.data(), batch.size(), any_hit, &stats.ls); });
         return uint64_t(active.size());
       };
 

@@ -58,9 +58,14 @@ struct RenderResult {
 // progress(done, total) is called after every pass (one sample per pixel).
 using Progress = std::function<void(int done, int total)>;
 
+// Traces one batch of rays with a structure, like trace_rays(); the GPU port passes its own.
+using BatchTracer = std::function<void(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+                                       lsk::LsCounters* counters)>;
+
 // structures: built structures keyed by canonical name; every schedule entry must be present.
+// tracer: where the batches are traced (empty: trace_rays on all CPU threads).
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
-                    const Progress& progress = {});
+                    const Progress& progress = {}, const BatchTracer& tracer = {});
 
 // Builds each distinct structure of the schedule once.
 std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule,

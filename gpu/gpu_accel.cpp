@@ -1,0 +1,31 @@
+#include "gpu_accel.h"
+
+namespace ls::gpu {
+
+GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
+    : nodes_(make_buffer(context, accel.nodes)),
+      tris_(make_buffer(context, accel.tris)),
+      tri_ids_(make_buffer(context, accel.tri_ids)),
+      tri_instances_(make_buffer(context, accel.tri_instances)),
+      top_nodes_(make_buffer(context, accel.top_nodes)),
+      instances_(make_buffer(context, accel.instances)),
+      node_ls_(make_buffer(context, accel.node_ls)),
+      ls_nodes_(make_buffer(context, accel.ls_nodes)),
+      ls_candidates_(make_buffer(context, accel.ls_candidates)),
+      tri_normals_(make_buffer(context, accel.tri_normals)) {
+  const lsk::TraceContext c = accel.context();  // the CPU's parameters, so both sides agree
+  params_.ls_enabled = c.ls_enabled;
+  params_.ls_n = c.ls_n;
+  params_.ls_cos2 = c.ls_cos2;
+  params_.two_level = accel.spec.two_level() ? 1u : 0u;
+}
+
+std::vector<const Buffer*> GpuAccel::bindings() const {
+  return {&nodes_, &tris_, &tri_ids_, &tri_instances_, &top_nodes_, &instances_, &node_ls_, &ls_nodes_, &ls_candidates_, &tri_normals_};
+}
+
+void GpuAccel::upload_candidates(const Accel& accel) {
+  if (!accel.ls_candidates.empty()) ls_candidates_.upload(accel.ls_candidates.data(), accel.ls_candidates.size() * sizeof(uint32_t));
+}
+
+}  // namespace ls::gpu

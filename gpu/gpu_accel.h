@@ -1,0 +1,29 @@
+// A structure's std430 arrays (ls::Accel, cpu/accel.h) uploaded unchanged to the GPU, in the binding
+// order of shaders/scene_buffers.glsl.
+#pragma once
+
+#include "accel.h"
+#include "shader_params.h"
+#include "vk_buffer.h"
+
+#include <vector>
+
+namespace ls::gpu {
+
+class GpuAccel {
+ public:
+  GpuAccel(const VulkanContext& context, const Accel& accel);
+
+  // Bindings 0..9 of scene_buffers.glsl.
+  std::vector<const Buffer*> bindings() const;
+  // Copies accel.ls_candidates again (after a search filled them).
+  void upload_candidates(const Accel& accel);
+  // The parameters of lsk::TraceContext for this structure (ls_enabled, ls_n, ls_cos2, two_level).
+  ShaderParams params() const { return params_; }
+
+ private:
+  Buffer nodes_, tris_, tri_ids_, tri_instances_, top_nodes_, instances_, node_ls_, ls_nodes_, ls_candidates_, tri_normals_;
+  ShaderParams params_;
+};
+
+}  // namespace ls::gpu

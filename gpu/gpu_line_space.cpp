@@ -1,0 +1,72 @@
+#include "gpu_line_space.h"
+
+#include "gpu_accel.h"
+#include "shaders.h"
+#include "vk_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace ls::gpu {
+namespace {
+constexpr uint32_t kGroup = 64;            // local_size_x of ls_candidates.comp
+constexpr size_t kBatchBytes = 64u << 20;  // search results per submission (bounded by the device too)
+}  // namespace
+
+void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearchTiming* timing) {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t ls_count = accel.ls_nodes.size();
+  const uint32_t shafts = uint32_t(accel.ls_info.shafts_per_ls);
+  GpuSearchTiming t;
+  size_t empty = 0;
+  if (ls_count > 0) {
+    const size_t bytes_per_node = size_t(shafts) * sizeof(uint32_t);
+    const size_t limit = std::min<size_t>(kBatchBytes, context.limits().maxStorageBufferRange);
+    const size_t batch = std::max<size_t>(1, std::min<size_t>({limit / bytes_per_node, ls_count, context.limits().maxComputeWorkGroupCount[1]}));
+    GpuAccel gpu(context, accel);  // the candidates are not read by the search
+    Buffer prims(context, batch * bytes_per_node);
+    ComputePipeline pipeline(context, spirv_ls_candidates(), 11, sizeof(ShaderParams));
+    KernelTimer timer(context);
+    std::vector<const Buffer*> bindings = gpu.bindings();
+    bindings.push_back(&prims);
+    pipeline.bind(bindings);
+    ShaderParams params = gpu.params();
+    params.ls_enabled = 0;
+    params.ls_n = uint32_t(accel.spec.subdivision);
+    params.inv_n = 1.0f / float(params.ls_n);  // the CPU builder's value
+    params.further_rays = uint32_t(accel.ls_options.further_rays);
+    params.search_instance = ls_search_instance(accel);
+    std::vector<uint32_t> host(batch * shafts);
+    for (size_t first = 0; first < ls_count; first += batch) {
+      params.first_ls = uint32_t(first);
+      params.ls_count = uint32_t(std::min(batch, ls_count - first));
+      context.submit_and_wait([&](VkCommandBuffer cmd) {
+        timer.begin(cmd);
+        pipeline.record(cmd, &params, (shafts + kGroup - 1) / kGroup, params.ls_count);
+        timer.end(cmd);
+      });
+      t.kernel_seconds += timer.seconds();
+      prims.download(host.data(), size_t(params.ls_count) * bytes_per_node);
+      for (uint32_t slot = 0; slot < params.ls_count; ++slot)
+        empty += pack_ls_candidates(accel, first + slot, host.data() + size_t(slot) * shafts);
+    }
+  }
+  t.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  accel.ls_info.empty_shafts = empty;
+  accel.ls_info.seconds = t.wall_seconds;
+  if (timing) *timing = t;
+}
+
+Accel build_accel_gpu(const VulkanContext& context, const Scene& scene, const StructureSpec& spec, const AccelOptions& options,
+                      GpuSearchTiming* timing) {
+  AccelOptions laid_out = options;
+  laid_out.search_candidates = false;
+  Accel accel = build_accel(scene, spec, laid_out);
+  if (spec.line_space()) {
+    search_candidates_gpu(context, accel, timing);
+    accel.build_seconds += accel.ls_info.seconds;
+  }
+  return accel;
+}
+
+}  // namespace ls::gpu

@@ -1,0 +1,42 @@
+// The scene's buffers, named like the pointer members of lsk::TraceContext (cpu/trace_context.h) so
+// that the single-source kernels read them unchanged, plus the parameters every kernel receives.
+// Mirrored on the host by gpu/shader_params.h (ShaderParams) and gpu/gpu_accel.cpp (binding order).
+#include "kernels/hit.h"
+#include "kernels/layouts.h"
+#include "kernels/line_space.h"
+#include "kernels/ray_box.h"
+#include "kernels/ray_triangle.h"
+
+layout(std430, binding = 0) readonly buffer Nodes { BvhNode nodes[]; };
+layout(std430, binding = 1) readonly buffer Tris { Triangle tris[]; };
+layout(std430, binding = 2) readonly buffer TriIds { uint tri_ids[]; };
+layout(std430, binding = 3) readonly buffer TriInstances { uint tri_instances[]; };
+layout(std430, binding = 4) readonly buffer TopNodes { BvhNode top_nodes[]; };
+layout(std430, binding = 5) readonly buffer Instances { InstanceRecord instances[]; };
+layout(std430, binding = 6) readonly buffer NodeLs { uint node_ls[]; };
+layout(std430, binding = 7) readonly buffer LsNodes { LsNode ls_nodes[]; };
+layout(std430, binding = 8) readonly buffer LsCandidates { uint ls_candidates[]; };
+layout(std430, binding = 9) readonly buffer TriNormals { uvec4 tri_normals[]; };
+
+layout(push_constant) uniform Params {
+  uint ls_enabled;       // trace: use the Line Space
+  uint ls_n;             // N
+  float ls_cos2;         // cos^2 of the refusal angle (negative: refuse all)
+  uint two_level;        // trace: 2L structure
+  uint any_hit;          // trace: stop at the first hit
+  uint first;            // trace: first ray of this dispatch
+  uint count;            // trace: rays in the buffer
+  float inv_n;           // candidates: 1 / N as the host computed it
+  uint further_rays;     // candidates: search rays after the midpoint ray
+  uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
+  uint first_ls;         // candidates: first LS node of this dispatch
+  uint ls_count;         // candidates: LS nodes in this dispatch
+} pc;
+
+uint ls_enabled = pc.ls_enabled;
+uint ls_n = pc.ls_n;
+float ls_cos2 = pc.ls_cos2;
+LsCounters ls_counters;
+
+#include "kernels/ls_lookup.h"
+#include "kernels/traverse_bvh.h"
