@@ -38,6 +38,19 @@ LS_FN float scale_pow2(float x, int e) {
 
 LS_FN vec3 scale_pow2(IN(vec3) v, int e) { return vec3(scale_pow2(v.x, e), scale_pow2(v.y, e), scale_pow2(v.z, e)); }
 
+// -0 as +0, decided on the bits: shader compilers may fold `x + 0.0f` to `x` (NIR does, even under
+// `precise`), so that idiom leaves -0 on the GPU where the CPU gives +0.
+LS_FN float positive_zero(float x) { return floatBitsToUint(x) == 0x80000000u ? 0.0f : x; }
+
+// a.x*b.x + a.y*b.y + a.z*b.z summed left to right.  GLSL leaves the order (and fusion) inside dot()
+// to the implementation and GLM sums a vec4 dot in pairs, so deciding arithmetic spells sums out.
+LS_FN float dot_in_order(IN(vec3) a, IN(vec3) b) {
+  precise float s = a.x * b.x;
+  s = s + a.y * b.y;
+  s = s + a.z * b.z;
+  return s;
+}
+
 LS_FN float max_abs(IN(vec3) v) { return max(max(abs(v.x), abs(v.y)), abs(v.z)); }
 
 #ifdef __cplusplus

@@ -68,16 +68,16 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   }
   Triangle tri = tris[prim];
   vec3 p0 = vec3(tri.v0);
-  vec3 e1 = vec3(tri.v1) - p0;
-  vec3 e2 = vec3(tri.v2) - p0;
+  precise vec3 e1 = vec3(tri.v1) - p0;
+  precise vec3 e2 = vec3(tri.v2) - p0;
   int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
-  vec3 n = cross(scale_pow2(e1, ke), scale_pow2(e2, ke));
-  float denom = dot(dir, n);
+  precise vec3 n = cross(scale_pow2(e1, ke), scale_pow2(e2, ke));
+  precise float denom = dot(dir, n);
   if (denom == 0.0f || dot(n, n) == 0.0f) {
     ls_counters.refused_parallel += 1u;
     return LS_FALLBACK;
   }
-  float t = dot(p0 - origin, n) / denom;
+  precise float t = dot(p0 - origin, n) / denom;
   if (!(t >= tmin)) {
     ls_counters.refused_behind += 1u;
     return LS_FALLBACK;
@@ -87,16 +87,18 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
     return LS_FALLBACK;
   }
   // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
-  vec3 q = origin + dir * t - p0;
-  float nn = dot(n, n);
-  float b1 = dot(cross(scale_pow2(q, ke), scale_pow2(e2, ke)), n) / nn;
-  float b2 = dot(cross(scale_pow2(e1, ke), scale_pow2(q, ke)), n) / nn;
-  float b0 = 1.0f - b1 - b2;
+  precise vec3 q = origin + dir * t - p0;
+  precise float nn = dot(n, n);
+  precise float b1 = dot(cross(scale_pow2(q, ke), scale_pow2(e2, ke)), n) / nn;
+  precise float b2 = dot(cross(scale_pow2(e1, ke), scale_pow2(q, ke)), n) / nn;
+  precise float b0 = 1.0f - b1 - b2;
   uvec4 packed = tri_normals[prim];
-  vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
-  float c = dot(dir, ne);
-  float ne2 = dot(ne, ne);
-  if (ne2 == 0.0f || c * c < ls_cos2 * dot(dir, dir) * ne2) {
+  precise vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
+  precise float c = dot(dir, ne);
+  precise float ne2 = dot(ne, ne);
+  precise float lhs = c * c;
+  precise float rhs = ls_cos2 * dot(dir, dir) * ne2;
+  if (ne2 == 0.0f || lhs < rhs) {
     ls_counters.refused_angle += 1u;
     return LS_FALLBACK;
   }

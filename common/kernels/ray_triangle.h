@@ -102,11 +102,11 @@ LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(ve
   f1 = scale_pow2(f1, kf);
   f2 = scale_pow2(f2, kf);
   precise vec3 n = cross(f1, f2);
-  precise float tn = dot(n, a);
-  precise float td = dot(n, r.dir);
+  precise float tn = dot_in_order(n, a);
+  precise float td = dot_in_order(n, r.dir);
   if (td == 0.0f) return false;
-  // dot(n, a) / dot(n, dir) is t scaled by 2^(ks - dir_exp); adding +0 turns -0 into +0.
-  precise float tt = scale_pow2(tn / td, r.dir_exp - ks) + 0.0f;
+  // dot(n, a) / dot(n, dir) is t scaled by 2^(ks - dir_exp); a t of -0 is reported as +0.
+  precise float tt = positive_zero(scale_pow2(tn / td, r.dir_exp - ks));
   if (!(tt >= tmin && tt <= tmax)) return false;
   t = tt;
   u = ev / det;

@@ -112,12 +112,13 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
     if (node.count > 0u) {
       for (uint i = node.first; i < node.first + node.count; ++i) {
         InstanceRecord rec = instances[i];
-        precise vec3 o = vec3(dot(rec.world_to_object0, vec4(ray.origin, 1.0f)),
-                              dot(rec.world_to_object1, vec4(ray.origin, 1.0f)),
-                              dot(rec.world_to_object2, vec4(ray.origin, 1.0f)));
-        precise vec3 d = vec3(dot(rec.world_to_object0, vec4(ray.dir, 0.0f)),
-                              dot(rec.world_to_object1, vec4(ray.dir, 0.0f)),
-                              dot(rec.world_to_object2, vec4(ray.dir, 0.0f)));
+        // Sums spelled out in one order (dot_in_order): CPU and GPU must carry the ray identically.
+        precise vec3 o = vec3(dot_in_order(vec3(rec.world_to_object0), ray.origin) + rec.world_to_object0.w,
+                              dot_in_order(vec3(rec.world_to_object1), ray.origin) + rec.world_to_object1.w,
+                              dot_in_order(vec3(rec.world_to_object2), ray.origin) + rec.world_to_object2.w);
+        precise vec3 d = vec3(dot_in_order(vec3(rec.world_to_object0), ray.dir),
+                              dot_in_order(vec3(rec.world_to_object1), ray.dir),
+                              dot_in_order(vec3(rec.world_to_object2), ray.dir));
         if (trace_bvh(rec.root, o, d, ray.tmin, rec.instance, any_hit, ls_enabled != 0u, hit, prim)) return finish_hit(hit);
       }
     } else {

@@ -1,0 +1,202 @@
+// The Vulkan port against the CPU reference, bit for bit (DESIGN §5, issue 5): Line Space candidates of
+// every shaft, traced hits (closest and any hit, all four structures), and renders.  These run on
+// whatever Vulkan device the machine has (lavapipe in CI); with no device at all they FAIL.
+#include "cross_check.h"
+#include "gpu_renderer.h"
+#include "load_scene.h"
+#include "path_tracer.h"
+#include "ray_generators.h"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <memory>
+
+using namespace ls;
+
+namespace {
+
+// One device for the whole test process (instance creation costs tens of ms, more the first time).
+const gpu::VulkanContext& device() {
+  static const std::unique_ptr<gpu::VulkanContext> context = std::make_unique<gpu::VulkanContext>();
+  return *context;
+}
+
+AccelOptions paper() {  // every node at depth D gets a Line Space, as in the paper
+  AccelOptions o;
+  o.ls.min_triangles = 0;
+  return o;
+}
+
+Scene scaled(const std::string& spec, float scale, glm::vec3 offset) {
+  Scene s = load_scene(spec);
+  scale_and_offset(s, scale, offset);
+  return s;
+}
+
+// A planar grid in z = 0 of 2 x cells^2 triangles: every LS box is flat (widened by the builder).
+Scene plane_scene(int cells) {
+  Scene s;
+  s.name = "plane";
+  s.materials.push_back(Material{});
+  Mesh m;
+  for (int y = 0; y <= cells; ++y)
+    for (int x = 0; x <= cells; ++x) {
+      m.positions.push_back(glm::vec3(-1.0f + 2.0f * float(x) / float(cells), -1.0f + 2.0f * float(y) / float(cells), 0.0f));
+      m.normals.push_back(glm::vec3(0, 0, 1));
+    }
+  for (int y = 0; y < cells; ++y)
+    for (int x = 0; x < cells; ++x) {
+      const uint32_t a = uint32_t(y * (cells + 1) + x), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
+      m.triangles.push_back(glm::uvec3(a, b, d));
+      m.triangles.push_back(glm::uvec3(a, d, c));
+    }
+  m.materials.assign(m.triangles.size(), 0);
+  s.meshes.push_back(m);
+  s.instances.push_back(Instance{0, glm::mat4(1.0f), "plane"});
+  s.camera = framing_camera(s);
+  validate_scene(s);
+  return s;
+}
+
+void require_candidates_equal(const Scene& scene, const std::string& structure, const AccelOptions& options = paper()) {
+  INFO(scene.name << " " << structure);
+  const validate::CrossCheckResult r = validate::cross_check_candidates(device(), scene, parse_structure(structure), options);
+  if (!r.ok()) validate::print_cross_check(stderr, scene.name + " " + structure + " candidates", r);
+  REQUIRE(r.compared > 0);
+  REQUIRE(r.mismatches == 0);
+}
+
+void require_hits_equal(const Scene& scene, const std::string& structure, const std::vector<lsk::Ray>& rays,
+                        const AccelOptions& options = paper()) {
+  for (bool any_hit : {false, true}) {
+    INFO(scene.name << " " << structure << (any_hit ? " any-hit" : " closest"));
+    const validate::CrossCheckResult r = validate::cross_check_hits(device(), scene, parse_structure(structure), rays, any_hit, options);
+    if (!r.ok()) validate::print_cross_check(stderr, scene.name + " " + structure + " hits", r);
+    REQUIRE(r.compared == rays.size());
+    REQUIRE(r.mismatches == 0);
+  }
+}
+
+std::vector<lsk::Ray> diffuse_rays(const Scene& scene, size_t count, uint32_t seed) {
+  return generate_rays(scene, build_accel(scene, parse_structure("bvh")), RayKind::Diffuse, count, seed);
+}
+
+std::vector<lsk::Ray> random_rays(const Scene& scene, size_t count, uint32_t seed) {
+  return generate_rays(scene, build_accel(scene, parse_structure("bvh")), RayKind::Random, count, seed);
+}
+
+}  // namespace
+
+TEST_CASE("a Vulkan device is present and named", "[gpu]") {
+  // Fails, rather than skips, on a machine without Vulkan: CI has lavapipe.
+  REQUIRE_FALSE(device().info().name.empty());
+  REQUIRE_FALSE(gpu::VulkanContext::list_devices().empty());
+}
+
+TEST_CASE("an unknown --device is bad input", "[gpu]") {
+  REQUIRE_THROWS_AS(gpu::VulkanContext("no such device anywhere"), InputError);
+  REQUIRE_THROWS_AS(gpu::VulkanContext("99"), InputError);
+}
+
+TEST_CASE("GPU candidates equal the CPU's for N in 1 2 6 10 flat and two-level at several depths", "[gpu]") {
+  const Scene objects = load_scene("builtin:generated:1200:3:5");
+  for (const char* s : {"f-ls:0:1", "f-ls:3:1", "2l-ls:2:1", "f-ls:0:2", "f-ls:4:2", "2l-ls:1:2", "f-ls:2:6", "f-ls:5:6",
+                        "2l-ls:0:6", "2l-ls:3:6", "f-ls:1:10", "2l-ls:2:10"})
+    require_candidates_equal(objects, s);
+}
+
+TEST_CASE("GPU candidates equal the CPU's on cornell with further search rays and both candidate sizes", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  AccelOptions further = paper();
+  further.ls.further_rays = 4;
+  require_candidates_equal(cornell, "f-ls:3:6", further);
+  AccelOptions four_bytes = paper();
+  four_bytes.ls.paper_candidates = true;
+  require_candidates_equal(cornell, "2l-ls:2:6", four_bytes);
+  require_candidates_equal(cornell, "f-ls:6:2", AccelOptions{});  // default minimum subtree size
+}
+
+TEST_CASE("GPU candidates equal the CPU's at the extremes - flat boxes and scales 1e-20 and 1e20 and offset 1e6", "[gpu]") {
+  const Scene plane = plane_scene(16);
+  for (const char* s : {"f-ls:0:6", "f-ls:3:2", "2l-ls:2:10"}) require_candidates_equal(plane, s);
+  for (const float scale : {1e-20f, 1e20f}) {
+    const Scene tiny_or_huge = scaled("builtin:generated:800:2:3", scale, glm::vec3(0.0f));
+    for (const char* s : {"f-ls:2:6", "2l-ls:1:2"}) require_candidates_equal(tiny_or_huge, s);
+  }
+  const Scene far = scaled("builtin:generated:800:2:3", 1.0f, glm::vec3(1e6f));
+  for (const char* s : {"f-ls:2:6", "2l-ls:1:2"}) require_candidates_equal(far, s);
+}
+
+TEST_CASE("GPU hits equal the CPU's bit for bit for all four structures closest and any hit", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  const std::vector<lsk::Ray> diffuse = diffuse_rays(cornell, 20000, 3);
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:3:6", "2l-ls:2:6", "f-ls:5:2"}) require_hits_equal(cornell, s, diffuse);
+  const Scene objects = load_scene("builtin:generated:1200:3:5");
+  const std::vector<lsk::Ray> random = random_rays(objects, 20000, 4);  // origins inside LS boxes too
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random);
+}
+
+TEST_CASE("GPU hits equal the CPU's at the extremes - flat boxes and scales 1e-20 and 1e20 and offset 1e6", "[gpu]") {
+  const Scene plane = plane_scene(16);
+  const std::vector<lsk::Ray> on_plane = random_rays(plane, 5000, 8);
+  for (const char* s : {"bvh", "f-ls:0:6", "2l-ls:2:2"}) require_hits_equal(plane, s, on_plane);
+  for (const float scale : {1e-20f, 1e20f}) {
+    const Scene tiny_or_huge = scaled("builtin:generated:800:2:3", scale, glm::vec3(0.0f));
+    const std::vector<lsk::Ray> rays = random_rays(tiny_or_huge, 5000, 9);
+    for (const char* s : {"bvh", "2l-bvh", "f-ls:2:6", "2l-ls:1:2"}) require_hits_equal(tiny_or_huge, s, rays);
+  }
+  const Scene far = scaled("builtin:generated:800:2:3", 1.0f, glm::vec3(1e6f));
+  const std::vector<lsk::Ray> rays = random_rays(far, 5000, 10);
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:2:6", "2l-ls:1:2"}) require_hits_equal(far, s, rays);
+}
+
+TEST_CASE("the cross-checks report a single changed candidate or hit bit", "[gpu]") {
+  const Scene scene = load_scene("builtin:generated:600:2:1");
+  const StructureSpec spec = parse_structure("f-ls:2:6");
+  const Accel cpu = build_accel(scene, spec, paper());
+  Accel changed = cpu;
+  REQUIRE(validate::compare_candidate_arrays(cpu, changed).ok());
+  changed.ls_candidates[changed.ls_candidates.size() / 2] ^= 1u;
+  const validate::CrossCheckResult r = validate::compare_candidate_arrays(cpu, changed);
+  REQUIRE(r.mismatches >= 1);
+  REQUIRE_FALSE(r.first.empty());
+
+  std::vector<lsk::Hit> hits(3);
+  for (lsk::Hit& h : hits) h = lsk::Hit{1.0f, 0u, 5u, 0.25f, 0.5f};
+  std::vector<lsk::Hit> other = hits;
+  other[1].t = std::nextafter(1.0f, 2.0f);  // one ulp
+  const lsk::LsCounters none{};
+  REQUIRE(validate::compare_hit_arrays(hits, hits, none, none).ok());
+  const validate::CrossCheckResult h = validate::compare_hit_arrays(hits, other, none, none);
+  REQUIRE(h.mismatches == 1);
+  REQUIRE(h.first[0].where == "ray 1");
+}
+
+TEST_CASE("a GPU render gives the CPU render's images bit for bit", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  RenderOptions options;
+  options.schedule = parse_schedule("bvh,f-ls:3:6,2l-ls:2:6");
+  options.width = 48;
+  options.height = 32;
+  options.spp = 2;
+  options.bounces = 3;
+  options.seed = 7;
+  const std::map<std::string, Accel> cpu_built = build_schedule_structures(cornell, options.schedule);
+  const std::map<std::string, Accel> gpu_built = gpu::build_schedule_structures_gpu(device(), cornell, options.schedule);
+  const RenderResult cpu = render(cornell, cpu_built, options);
+  const RenderResult gpu = gpu::render_gpu(device(), cornell, gpu_built, options);
+  REQUIRE(gpu.bounce_images.size() == cpu.bounce_images.size());
+  for (size_t k = 0; k < cpu.bounce_images.size(); ++k) {
+    INFO("bounce " << k);
+    REQUIRE(cpu.bounces[k].extension_rays == gpu.bounces[k].extension_rays);
+    REQUIRE(cpu.bounces[k].shadow_rays == gpu.bounces[k].shadow_rays);
+    REQUIRE(std::memcmp(&cpu.bounces[k].ls, &gpu.bounces[k].ls, sizeof(lsk::LsCounters)) == 0);
+    REQUIRE(std::memcmp(cpu.bounce_images[k].data(), gpu.bounce_images[k].data(), cpu.bounce_images[k].size() * sizeof(glm::vec3)) == 0);
+  }
+  REQUIRE(std::memcmp(cpu.total.data(), gpu.total.data(), cpu.total.size() * sizeof(glm::vec3)) == 0);
+  // Not trivially equal: the image holds light.
+  float sum = 0.0f;
+  for (const glm::vec3& c : gpu.total) sum += c.x + c.y + c.z;
+  REQUIRE(sum > 0.0f);
+}

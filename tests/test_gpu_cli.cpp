@@ -1,0 +1,109 @@
+// linespace-gpu end to end: bad input exits 2 with a one-line reason (no device or a wrong --device
+// included), and its hit files, build report and render equal linespace-cpu's.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+fs::path temp(const std::string& name) {
+  return fs::temp_directory_path() / ("linespace_gpu_cli_test_" + std::to_string(getpid())) / name;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+Run run(const std::string& program, const std::string& args, const std::string& env = "") {
+  fs::create_directories(temp(""));
+  const std::string out = temp("stdout").string(), err = temp("stderr").string();
+  const std::string cmd = env + " " + program + " " + args + " >" + out + " 2>" + err;
+  const int raw = std::system(cmd.c_str());
+  Run r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+size_t line_count(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
+
+}  // namespace
+
+TEST_CASE("linespace-gpu bad input exits 2 with a one-line reason", "[gpu_cli]") {
+  fs::create_directories(temp(""));
+  std::ofstream(temp("odd.rays"), std::ios::binary) << std::string(33, '\0');
+  const std::string cases[] = {
+      "build --scene builtin:nope",
+      "build --structure octree",
+      "build --device no-such-device",
+      "build --device 99",
+      "render --size 0x10 --out " + temp("r").string(),
+      "render --schedule bvh,,bvh --size 8x8 --out " + temp("r").string(),
+      "trace --rays " + temp("odd.rays").string() + " --hits " + temp("h").string(),
+      "bench --structures f-ls:8",
+      "frobnicate",
+  };
+  for (const std::string& args : cases) {
+    const Run r = run(LINESPACE_GPU, args);
+    INFO(args << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+  }
+}
+
+TEST_CASE("linespace-gpu without any Vulkan driver exits 2 with a one-line reason", "[gpu_cli]") {
+  // An ICD list naming no driver file: the loader finds no device.
+  const Run r = run(LINESPACE_GPU, "build --scene builtin:cornell", "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json");
+  INFO(r.err);
+  CHECK(r.status == 2);
+  CHECK(line_count(r.err) == 1);
+  CHECK(r.err.find("Vulkan") != std::string::npos);
+}
+
+TEST_CASE("linespace-gpu trace writes the hit file linespace-cpu writes", "[gpu_cli]") {
+  const std::string rays = temp("diffuse.rays").string();
+  REQUIRE(run(LINESPACE_CPU, "rays --scene builtin:cornell --kind diffuse --count 3000 --seed 4 --out " + rays).status == 0);
+  for (const char* s : {"bvh", "2l-ls:2:6"}) {
+    INFO(s);
+    REQUIRE(run(LINESPACE_CPU, std::string("trace --structure ") + s + " --rays " + rays + " --hits " + temp("cpu.hits").string()).status == 0);
+    const Run g = run(LINESPACE_GPU, std::string("trace --structure ") + s + " --rays " + rays + " --hits " + temp("gpu.hits").string());
+    INFO(g.err);
+    REQUIRE(g.status == 0);
+    const std::string a = slurp(temp("cpu.hits")), b = slurp(temp("gpu.hits"));
+    REQUIRE(a.size() == 3000u * 20u);
+    REQUIRE(a == b);
+  }
+}
+
+TEST_CASE("linespace-gpu build and render report the device and the CPU's sizes", "[gpu_cli]") {
+  const Run g = run(LINESPACE_GPU, "build --structure f-ls:3:2 --json");
+  const Run c = run(LINESPACE_CPU, "build --structure f-ls:3:2 --json");
+  REQUIRE(g.status == 0);
+  REQUIRE(c.status == 0);
+  const auto jg = nlohmann::json::parse(g.out), jc = nlohmann::json::parse(c.out);
+  CHECK_FALSE(jg.at("device").get<std::string>().empty());
+  for (const char* key : {"triangles", "nodes", "ls_nodes", "shafts_per_ls", "empty_shafts", "bytes_total", "bytes_ls"})
+    CHECK(jg.at(key) == jc.at(key));
+  const std::string out = temp("render").string();
+  const Run r = run(LINESPACE_GPU, "render --size 16x12 --spp 1 --bounces 1 --quiet --out " + out);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  for (const char* f : {"total.exr", "bounce_0.exr", "bounce_1.exr", "image.png", "report.json"}) CHECK(fs::exists(out + "/" + f));
+  CHECK_FALSE(nlohmann::json::parse(slurp(out + "/report.json")).at("device").get<std::string>().empty());
+}
