@@ -1,0 +1,69 @@
+// Command-line pieces shared by linespace-cpu, linespace-gpu and linespace-validate: the image size
+// and the Line Space flags, so every program spells and checks them the same way.
+#pragma once
+
+#include "accel.h"
+#include "scene.h"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace ls {
+
+struct Size {
+  uint32_t width = 512, height = 512;
+};
+
+inline Size parse_size(const std::string& text) {
+  const size_t x = text.find('x');
+  Size s;
+  try {
+    size_t used_w = 0, used_h = 0;
+    if (x == std::string::npos) throw std::invalid_argument("x");
+    const long w = std::stol(text.substr(0, x), &used_w);
+    const long h = std::stol(text.substr(x + 1), &used_h);
+    if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("trailing");
+    if (w < 1 || h < 1 || w > 16384 || h > 16384) throw InputError("--size " + text + ": width and height must be in [1, 16384]");
+    s.width = uint32_t(w);
+    s.height = uint32_t(h);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception&) {
+    throw InputError("--size '" + text + "' is not WIDTHxHEIGHT (e.g. 512x512)");
+  }
+  return s;
+}
+
+// Line Space options shared by every subcommand that builds a structure.
+struct LsFlags {
+  double angle = LsOptions{}.angle_degrees;
+  int further_rays = LsOptions{}.further_rays;
+  uint32_t min_triangles = LsOptions{}.min_triangles;
+  std::string candidates = "compact";
+  double max_memory_mb = 0.0;
+
+  void add_to(CLI::App* app) {
+    app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
+        ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+    app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
+        ->capture_default_str()->check(CLI::Range(0, 1024));
+    app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
+        ->capture_default_str();
+    app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
+        ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
+    app->add_option("--max-memory", max_memory_mb, "refuse a Line Space estimated above this many MB (0: half of RAM)")
+        ->check(CLI::Range(0.0, 1e9));
+  }
+  AccelOptions options() const {
+    AccelOptions o;
+    o.ls.angle_degrees = float(angle);
+    o.ls.further_rays = further_rays;
+    o.ls.min_triangles = min_triangles;
+    o.ls.paper_candidates = candidates == "paper";
+    o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    return o;
+  }
+};
+
+}  // namespace ls
