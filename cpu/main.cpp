@@ -1,8 +1,9 @@
 // linespace-cpu: the command line of the CPU reference (DESIGN §9).
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
 #include "accel.h"
+#include "cli_flags.h"
+#include "cli_report.h"
 #include "bench.h"
-#include "cli_shared.h"
 #include "load_scene.h"
 #include "path_tracer.h"
 #include "ray_files.h"

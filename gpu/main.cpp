@@ -2,7 +2,8 @@
 // plus --device NAME|INDEX.  Every figure is printed with the device's name.
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
 #include "accel.h"
-#include "cli_shared.h"
+#include "cli_flags.h"
+#include "cli_report.h"
 #include "gpu_line_space.h"
 #include "gpu_renderer.h"
 #include "gpu_trace.h"

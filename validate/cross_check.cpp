@@ -3,6 +3,9 @@
 #include "gpu_accel.h"
 #include "gpu_line_space.h"
 #include "gpu_trace.h"
+#include "load_scene.h"
+#include "ray_files.h"
+#include "ray_generators.h"
 
 #include <cstring>
 
@@ -120,6 +123,51 @@ void print_cross_check(std::FILE* out, const std::string& what, const CrossCheck
   std::fprintf(out, "%s: %zu compared, %zu mismatches%s\n", what.c_str(), result.compared, result.mismatches,
                result.ok() ? "" : " (first listed: where: cpu | gpu)");
   for (const Mismatch& m : result.first) std::fprintf(out, "  %s: %s | %s\n", m.where.c_str(), m.cpu.c_str(), m.gpu.c_str());
+}
+
+namespace {
+
+Scene command_scene(const CrossCheckCommand& c) {
+  Scene scene = load_scene(c.scene);
+  if (c.scale != 1.0f || c.offset[0] != 0.0f || c.offset[1] != 0.0f || c.offset[2] != 0.0f)
+    scale_and_offset(scene, c.scale, glm::vec3(c.offset[0], c.offset[1], c.offset[2]));
+  return scene;
+}
+
+std::string label(const CrossCheckCommand& c, const gpu::VulkanContext& context) {
+  std::string s = c.scene + " " + c.structure;
+  if (c.scale != 1.0f) s += " scale " + std::to_string(c.scale);
+  if (c.offset[0] != 0.0f || c.offset[1] != 0.0f || c.offset[2] != 0.0f) s += " offset";
+  return s + " on " + context.description();
+}
+
+}  // namespace
+
+int run_candidates_command(const CrossCheckCommand& command, const AccelOptions& options) {
+  const Scene scene = command_scene(command);
+  const StructureSpec spec = parse_structure(command.structure);
+  const gpu::VulkanContext context(command.device);
+  const CrossCheckResult r = cross_check_candidates(context, scene, spec, options);
+  print_cross_check(stdout, "candidates, " + label(command, context) + " (shafts)", r);
+  return r.ok() ? 0 : 1;
+}
+
+int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options) {
+  const Scene scene = command_scene(command);
+  const StructureSpec spec = parse_structure(command.structure);
+  std::vector<lsk::Ray> rays;
+  if (!command.rays.empty()) {
+    rays = read_rays(command.rays);
+  } else {
+    const RayKind kind = parse_ray_kind(command.kind);
+    rays = generate_rays(scene, build_accel(scene, parse_structure("bvh")), kind, command.count, command.seed);
+  }
+  if (rays.empty()) throw InputError("hits: no rays to trace");
+  const gpu::VulkanContext context(command.device);
+  const CrossCheckResult r = cross_check_hits(context, scene, spec, rays, command.any_hit, options);
+  print_cross_check(stdout, std::string("hits (") + (command.any_hit ? "any hit" : "closest hit") + "), " + label(command, context) +
+                                " (rays)", r);
+  return r.ok() ? 0 : 1;
 }
 
 }  // namespace ls::validate

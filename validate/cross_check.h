@@ -44,4 +44,21 @@ CrossCheckResult cross_check_hits(const gpu::VulkanContext& context, const Scene
 // "what: N compared, M mismatches" and the first mismatches, one per line.
 void print_cross_check(std::FILE* out, const std::string& what, const CrossCheckResult& result);
 
+// The `candidates` and `hits` subcommands of linespace-validate.
+struct CrossCheckCommand {
+  std::string scene = "builtin:cornell";
+  std::string structure = "f-ls:4:6";
+  std::string device;               // Vulkan device: index or part of its name (empty: preferred)
+  std::string rays;                 // hits: a ray file; empty: `count` rays of `kind` made here
+  std::string kind = "diffuse";
+  size_t count = 100000;
+  uint32_t seed = 1;
+  bool any_hit = false;
+  float scale = 1.0f;               // applied to the scene first (numerical extremes)
+  float offset[3] = {0.0f, 0.0f, 0.0f};
+};
+// Print the counts and first mismatches; return 0 when identical, 1 otherwise (InputError: bad input).
+int run_candidates_command(const CrossCheckCommand& command, const AccelOptions& options);
+int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options);
+
 }  // namespace ls::validate

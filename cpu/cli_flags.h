@@ -1,13 +1,12 @@
-// Command-line pieces shared by linespace-cpu and linespace-gpu (DESIGN §9: both programs take the
-// same subcommands and flags): --size parsing, the Line Space flags, and the build/counter reports.
-// Include only from a program's main.cpp: LsFlags needs CLI11, which is slow to compile.
+// Command-line pieces shared by linespace-cpu, linespace-gpu and linespace-validate: the image size
+// and the Line Space flags, so every program spells and checks them the same way.
 #pragma once
 
 #include "accel.h"
+#include "scene.h"
 
 #include <CLI/CLI.hpp>
 
-#include <cstdint>
 #include <string>
 
 namespace ls {
@@ -16,14 +15,25 @@ struct Size {
   uint32_t width = 512, height = 512;
 };
 
-// "WIDTHxHEIGHT", each in [1, 16384]; throws InputError.
-Size parse_size(const std::string& text);
-
-// Prints what `build` reports (DESIGN §9 keys); `device`, when given, names who built the candidates.
-void print_build(const Accel& a, bool json, const std::string& device = "");
-
-// Line Space lookup counters, one line on stderr.
-void print_counters(const lsk::LsCounters& c);
+inline Size parse_size(const std::string& text) {
+  const size_t x = text.find('x');
+  Size s;
+  try {
+    size_t used_w = 0, used_h = 0;
+    if (x == std::string::npos) throw std::invalid_argument("x");
+    const long w = std::stol(text.substr(0, x), &used_w);
+    const long h = std::stol(text.substr(x + 1), &used_h);
+    if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("trailing");
+    if (w < 1 || h < 1 || w > 16384 || h > 16384) throw InputError("--size " + text + ": width and height must be in [1, 16384]");
+    s.width = uint32_t(w);
+    s.height = uint32_t(h);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception&) {
+    throw InputError("--size '" + text + "' is not WIDTHxHEIGHT (e.g. 512x512)");
+  }
+  return s;
+}
 
 // Line Space options shared by every subcommand that builds a structure.
 struct LsFlags {

@@ -1,4 +1,4 @@
-#include "cli_shared.h"
+#include "cli_report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -6,26 +6,6 @@
 #include <iostream>
 
 namespace ls {
-
-Size parse_size(const std::string& text) {
-  const size_t x = text.find('x');
-  Size s;
-  try {
-    size_t used_w = 0, used_h = 0;
-    if (x == std::string::npos) throw std::invalid_argument("x");
-    const long w = std::stol(text.substr(0, x), &used_w);
-    const long h = std::stol(text.substr(x + 1), &used_h);
-    if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("trailing");
-    if (w < 1 || h < 1 || w > 16384 || h > 16384) throw InputError("--size " + text + ": width and height must be in [1, 16384]");
-    s.width = uint32_t(w);
-    s.height = uint32_t(h);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception&) {
-    throw InputError("--size '" + text + "' is not WIDTHxHEIGHT (e.g. 512x512)");
-  }
-  return s;
-}
 
 void print_build(const Accel& a, bool json, const std::string& device) {
   if (json) {

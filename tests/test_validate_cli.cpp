@@ -1,0 +1,103 @@
+// linespace-validate end to end: bad input exits 2 with one line, and each study writes the files and
+// keys DESIGN §9 promises, with figures that must hold by construction.
+#include "run_program.h"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+
+using namespace test_support;
+namespace fs = std::filesystem;
+
+namespace {
+
+Run validate(const std::string& args) { return run_program(LINESPACE_VALIDATE, args, "validate_cli"); }
+fs::path temp(const std::string& name) { return temp_path("validate_cli", name); }
+
+}  // namespace
+
+TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
+  fs::create_directories(temp(""));
+  { std::ofstream(temp("broken.gltf")) << "{ not json"; }
+  const std::array<std::string, 14> cases = {
+      "rmse --scene /nonexistent.glb",
+      "rmse --scene " + temp("broken.gltf").string(),
+      "rmse --scene builtin:nothing",
+      "rmse --structures f-ls:8",
+      "rmse --structures f-ls:8:6,",
+      "rmse --size 0x10",
+      "rmse --size 12",
+      "rmse --bounces 0",
+      "rmse --device quantum",
+      "sweep --depths 0,99",
+      "sweep --families bvh",
+      "sweep --start-bounce 5 --bounces 3",
+      "paper --tables 5",
+      "paper --subdivisions 7",
+  };
+  for (const std::string& c : cases) {
+    INFO(c);
+    const Run r = validate(c + " --out " + temp("unused").string());
+    REQUIRE(r.status == 2);
+    REQUIRE(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    REQUIRE(r.err.rfind("linespace-validate: ", 0) == 0);
+  }
+  REQUIRE(validate("").status == 2);
+}
+
+TEST_CASE("linespace-validate rmse writes rmse.json with the documented keys and heat-maps", "[cli]") {
+  const fs::path out = temp("rmse");
+  const Run r = validate("rmse --scene builtin:generated:2000:4:1 --structures f-ls:4:4,2l-ls:0:4 --size 16x16 "
+                         "--spp 1 --bounces 2 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "rmse.json"));
+  REQUIRE(j["rows"].size() == 4);
+  for (const auto& row : j["rows"]) {
+    for (const char* key : {"structure", "start_bounce", "rmse", "mrays_per_s", "bytes"}) REQUIRE(row.contains(key));
+    REQUIRE(row["contribution_rmse"].size() == 3);
+    // Bounces before the switch are exact.
+    for (int b = 0; b < row["start_bounce"].get<int>(); ++b) REQUIRE(row["contribution_rmse"][size_t(b)] == 0.0);
+  }
+  for (const char* f : {"rmse.md", "rmse.csv", "reference.png", "f-ls_4_4_from_bounce_1_heatmap.png",
+                        "2l-ls_0_4_from_bounce_2_side_by_side.png"})
+    REQUIRE(fs::file_size(out / f) > 0);
+}
+
+TEST_CASE("linespace-validate sweep writes the data and the trade-off plot", "[cli]") {
+  const fs::path out = temp("sweep");
+  const Run r = validate("sweep --scene builtin:generated:2000:4:1 --depths 0,3 --subdivisions 3 --angles 0,45 "
+                         "--size 16x16 --spp 1 --bounces 1 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "sweep.json"));
+  REQUIRE(j["points"].size() == 8);  // 2 angles x 2 families x 2 depths x 1 subdivision
+  int front = 0;
+  for (const auto& p : j["points"]) {
+    if (p["angle"] == 0.0) REQUIRE(p["rmse"] == 0.0);  // refusing every approximation is exact
+    front += p["pareto"].get<bool>();
+  }
+  REQUIRE(front >= 1);
+  REQUIRE(fs::file_size(out / "tradeoff.png") > 1000);
+  REQUIRE(fs::file_size(out / "tradeoff.svg") > 1000);
+}
+
+TEST_CASE("linespace-validate paper prints the three tables and the claims", "[cli]") {
+  const fs::path out = temp("paper");
+  const Run r = validate("paper --scenes builtin:generated:1500:4:1 --subdivisions 6 --size 12x12 --spp 1 --out " +
+                         out.string() + " --max-memory 200");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  for (const char* heading : {"Table 2 analogue", "Table 3 analogue", "Table 4 analogue", "claims hold here"})
+    REQUIRE(r.out.find(heading) != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "paper.json"));
+  REQUIRE(j["scenes"].size() == 1);
+  const auto& t4 = j["scenes"][0]["table4"];
+  REQUIRE(t4.size() == 7);
+  REQUIRE(t4[0]["schedule"] == "bvh");
+  REQUIRE(t4[0]["rmse"] == 0.0);  // the all-exact schedule against itself
+  REQUIRE(j["claims"].size() >= 6);
+  for (const auto& c : j["claims"]) REQUIRE(c["checked"].get<int>() >= c["held"].get<int>());
+}

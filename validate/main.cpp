@@ -1,0 +1,207 @@
+// linespace-validate: measures what the Line Space's approximation costs in image error and buys in
+// speed and memory (DESIGN §7, §9).
+// Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
+#include "cli_flags.h"
+#include "cross_check.h"
+#include "load_scene.h"
+#include "paper_tables.h"
+#include "rmse_study.h"
+#include "sweep.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <set>
+#include <iostream>
+
+namespace {
+
+using namespace ls;
+
+// Image settings shared by every study.
+struct ImageFlags {
+  std::string size = "256x256";
+  int spp = 4, bounces = 3;
+  uint32_t seed = 1;
+
+  void add_to(CLI::App* app) {
+    app->add_option("--size", size, "WIDTHxHEIGHT")->capture_default_str();
+    app->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 16));
+    app->add_option("--bounces", bounces, "indirect bounces after the primary hit")->capture_default_str()->check(CLI::Range(1, 64));
+    app->add_option("--seed", seed)->capture_default_str();
+  }
+  ImageSettings settings() const {
+    const Size s = parse_size(size);
+    ImageSettings i;
+    i.width = s.width;
+    i.height = s.height;
+    i.spp = spp;
+    i.bounces = bounces;
+    i.seed = seed;
+    return i;
+  }
+};
+
+void log_line(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
+
+// The plot is a separate step so it can be replaced: Debian's python3 with matplotlib.
+void plot_sweep(const std::string& dir) {
+  const std::string cmd = "/usr/bin/python3 '" LINESPACE_PLOT_SCRIPT "' '" + dir + "'";
+  const int status = std::system(cmd.c_str());
+  if (status != 0)
+    throw InputError("the plot step failed (" + cmd + "); it needs Debian's python3-matplotlib, which scripts/setup.sh "
+                     "installs. The data is in " + dir + "/sweep.{csv,json}");
+}
+
+std::set<int> int_set(const std::string& text, const std::string& flag, int lo, int hi) {
+  const std::vector<int> v = parse_int_list(text, flag, lo, hi);
+  return {v.begin(), v.end()};
+}
+
+std::vector<std::string> scene_list(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty()) throw InputError("--scenes '" + text + "': empty scene name");
+    out.push_back(item);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"linespace-validate: image error, speed and memory of the Line Space, measured"};
+  app.require_subcommand(1);
+  std::string scene_spec = "builtin:cornell", device = "cpu", out_dir;
+  LsFlags ls_flags;
+  ImageFlags image_flags;
+
+  std::string structures = "f-ls:8:6,2l-ls:4:6";
+  float heatmap_max = 0.1f;
+  auto* rmse_cmd = app.add_subcommand("rmse", "RMSE per start bounce against the all-exact render (the paper's Table 3)");
+  rmse_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
+  rmse_cmd->add_option("--structures", structures, "comma-separated structures")->capture_default_str();
+  rmse_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
+  rmse_cmd->add_option("--out", out_dir, "folder for rmse.{md,csv,json}, heat-maps and images")->default_val("out/rmse");
+  rmse_cmd->add_option("--heatmap-max", heatmap_max, "per-pixel error at the top of the heat-map's ramp")
+      ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
+  image_flags.add_to(rmse_cmd);
+  ls_flags.add_to(rmse_cmd);
+
+  std::string families = "f-ls,2l-ls", depths = "0,2,4,6,8", subdivisions = "4,6,8", angles = "45";
+  int start_bounce = 1;
+  bool no_plot = false;
+  auto* sweep_cmd = app.add_subcommand("sweep", "MRays/s against RMSE over D, N and the refusal angle; plots the trade-off");
+  sweep_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
+  sweep_cmd->add_option("--families", families, "f-ls, 2l-ls or both")->capture_default_str();
+  sweep_cmd->add_option("--depths", depths, "integration depths D")->capture_default_str();
+  sweep_cmd->add_option("--subdivisions", subdivisions, "subdivisions N")->capture_default_str();
+  sweep_cmd->add_option("--angles", angles, "refusal angles in degrees")->capture_default_str();
+  sweep_cmd->add_option("--start-bounce", start_bounce, "the Line Space traces bounces >= this one")->capture_default_str();
+  sweep_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
+  sweep_cmd->add_option("--out", out_dir, "folder for sweep.{csv,json,md} and tradeoff.{png,svg}")->default_val("out/sweep");
+  sweep_cmd->add_flag("--no-plot", no_plot, "write the data only");
+  image_flags.add_to(sweep_cmd);
+  ls_flags.add_to(sweep_cmd);
+
+  std::string scenes = "builtin:cornell", tables = "2,3,4", paper_n = "6,10";
+  auto* paper_cmd = app.add_subcommand("paper", "the paper's Tables 2, 3 and 4 on our scenes, beside the paper's figures");
+  paper_cmd->add_option("--scenes", scenes, "comma-separated scenes")->capture_default_str();
+  paper_cmd->add_option("--tables", tables, "which of Tables 2, 3, 4")->capture_default_str();
+  paper_cmd->add_option("--subdivisions", paper_n, "the paper's N to run: 6, 10 or both")->capture_default_str();
+  paper_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
+  paper_cmd->add_option("--out", out_dir, "folder for paper.{md,json} and each scene's rmse files")->default_val("out/paper");
+  paper_cmd->add_option("--heatmap-max", heatmap_max, "per-pixel error at the top of the heat-map's ramp")
+      ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
+  image_flags.add_to(paper_cmd);
+  ls_flags.add_to(paper_cmd);
+
+  // CPU-versus-GPU cross-checks (issue 5): exit 1 on any difference.
+  validate::CrossCheckCommand check;
+  std::vector<float> check_offset;
+  auto add_check_flags = [&](CLI::App* cmd) {
+    cmd->add_option("--scene", check.scene, "scene file or builtin:NAME")->capture_default_str();
+    cmd->add_option("--structure", check.structure, "bvh, 2l-bvh, f-ls:D:N or 2l-ls:D:N")->capture_default_str();
+    cmd->add_option("--device", check.device, "Vulkan device: index or part of its name (default: discrete GPU first)");
+    cmd->add_option("--scale", check.scale, "scale the scene first (numerical extremes)")->capture_default_str();
+    cmd->add_option("--offset", check_offset, "then move it by X Y Z")->expected(3);
+    ls_flags.add_to(cmd);
+  };
+  auto* candidates_cmd = app.add_subcommand("candidates", "Line Space candidates built on CPU and GPU, compared shaft by shaft");
+  add_check_flags(candidates_cmd);
+  auto* hits_cmd = app.add_subcommand("hits", "hits traced on CPU and GPU, compared (ids and the bits of t, u, v)");
+  add_check_flags(hits_cmd);
+  hits_cmd->add_option("--rays", check.rays, "ray file (default: --count rays of --kind made here)");
+  hits_cmd->add_option("--kind", check.kind, "primary, diffuse or random")->capture_default_str();
+  hits_cmd->add_option("--count", check.count)->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 26));
+  hits_cmd->add_option("--seed", check.seed)->capture_default_str();
+  hits_cmd->add_flag("--any-hit", check.any_hit, "stop at the first hit in [tmin, tmax]");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "linespace-validate: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+
+  try {
+    for (size_t i = 0; i < check_offset.size() && i < 3; ++i) check.offset[i] = check_offset[i];
+    if (*candidates_cmd) return validate::run_candidates_command(check, ls_flags.options());
+    if (*hits_cmd) return validate::run_hits_command(check, ls_flags.options());
+    if (*rmse_cmd) {
+      const std::vector<StructureSpec> specs = parse_structure_list(structures);
+      const ImageSettings settings = image_flags.settings();
+      const Scene scene = load_scene(scene_spec);
+      auto renderer = make_study_renderer(device, scene, ls_flags.options());
+      const RmseStudy study = run_rmse_study(*renderer, scene_spec, specs, settings, out_dir, heatmap_max, log_line);
+      write_rmse_study(out_dir, study);
+      std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\nwrote %s/{rmse.md, rmse.csv, rmse.json, *_heatmap.png, "
+                  "*_side_by_side.png}\n",
+                  scene_spec.c_str(), settings.width, settings.height, settings.spp, settings.bounces,
+                  study.device.c_str(), study.summary().markdown().c_str(), out_dir.c_str());
+    } else if (*sweep_cmd) {
+      SweepGrid grid;
+      grid.families = parse_families(families);
+      grid.depths = parse_int_list(depths, "--depths", 0, kMaxLsDepth);
+      grid.subdivisions = parse_int_list(subdivisions, "--subdivisions", 1, kMaxLsSubdivision);
+      grid.angles = parse_angle_list(angles);
+      grid.start_bounce = start_bounce;
+      const ImageSettings settings = image_flags.settings();
+      const Scene scene = load_scene(scene_spec);
+      const AccelOptions accel_options = ls_flags.options();
+      auto renderer = make_study_renderer(device, scene, accel_options);
+      const Sweep sweep = run_sweep(*renderer, scene_spec, grid, settings, accel_options.ls, log_line);
+      write_sweep(out_dir, sweep);
+      std::printf("%s\nwrote %s/{sweep.csv, sweep.json, sweep.md}\n", sweep.table().markdown().c_str(), out_dir.c_str());
+      if (!no_plot) {
+        plot_sweep(out_dir);
+        std::printf("wrote %s/{tradeoff.png, tradeoff.svg}\n", out_dir.c_str());
+      }
+    } else if (*paper_cmd) {
+      PaperOptions options;
+      options.scenes = scene_list(scenes);
+      options.tables = int_set(tables, "--tables", 2, 4);
+      options.subdivisions = int_set(paper_n, "--subdivisions", 6, 10);
+      options.settings = image_flags.settings();
+      options.device = device;
+      options.heatmap_max = heatmap_max;
+      const PaperReport report = run_paper(options, ls_flags.options(), out_dir, log_line);
+      std::printf("%s\nwrote %s/{paper.md, paper.json}\n", report.markdown.c_str(), out_dir.c_str());
+    }
+  } catch (const InputError& e) {
+    std::cerr << "linespace-validate: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "linespace-validate: error: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

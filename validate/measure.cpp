@@ -1,0 +1,40 @@
+#include "measure.h"
+
+#include "image_metrics.h"
+
+namespace ls {
+
+RenderOptions ImageSettings::options(const Schedule& schedule) const {
+  RenderOptions o;
+  o.schedule = schedule;
+  o.width = width;
+  o.height = height;
+  o.spp = spp;
+  o.bounces = bounces;
+  o.seed = seed;
+  return o;
+}
+
+Reference render_reference(StudyRenderer& renderer, const ImageSettings& settings) {
+  const Schedule exact = parse_schedule("bvh");
+  Reference r;
+  r.result = renderer.render(settings.options(exact));
+  r.scale = exposure_scale(r.result.total);
+  r.bytes = schedule_bytes(renderer, exact, settings.bounces);
+  return r;
+}
+
+Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageSettings& settings,
+                 const Reference& reference) {
+  Measured m;
+  m.schedule = schedule.name();
+  m.result = renderer.render(settings.options(schedule));
+  m.rmse = rmse(reference.result.total, m.result.total, reference.scale);
+  for (size_t k = 0; k < m.result.bounce_images.size(); ++k)
+    m.contribution_rmse.push_back(rmse(reference.result.bounce_images[k], m.result.bounce_images[k], reference.scale));
+  m.mrays_per_s = m.result.indirect_mrays_per_s();
+  m.bytes = schedule_bytes(renderer, schedule, settings.bounces);
+  return m;
+}
+
+}  // namespace ls

@@ -1,0 +1,41 @@
+// One measurement of the validator: render a schedule with the same random numbers as the all-exact
+// reference and compare (DESIGN §6–7).  The RMSE of the total image is the figure the paper reports;
+// the RMSE of each bounce's own contribution shows where the error comes from.
+#pragma once
+
+#include "path_tracer.h"
+#include "study_renderer.h"
+
+#include <string>
+#include <vector>
+
+namespace ls {
+
+struct ImageSettings {
+  uint32_t width = 256, height = 256;
+  int spp = 4;
+  int bounces = 3;
+  uint32_t seed = 1;
+  RenderOptions options(const Schedule& schedule) const;
+};
+
+struct Reference {
+  RenderResult result;  // the all-exact (F-BVH) render
+  float scale = 1.0f;   // e of DESIGN §7, from its total image
+  size_t bytes = 0;
+};
+
+struct Measured {
+  std::string schedule;
+  double rmse = 0.0;                      // total image
+  std::vector<double> contribution_rmse;  // bounce 0..B images
+  double mrays_per_s = 0.0;               // rays of bounces >= 1 per second of tracing
+  size_t bytes = 0;                       // distinct structures of the schedule
+  RenderResult result;
+};
+
+Reference render_reference(StudyRenderer& renderer, const ImageSettings& settings);
+Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageSettings& settings,
+                 const Reference& reference);
+
+}  // namespace ls

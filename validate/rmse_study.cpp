@@ -1,0 +1,175 @@
+#include "rmse_study.h"
+
+#include "heatmap.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+namespace ls {
+
+namespace {
+
+Image as_image(const RenderResult& r, const std::vector<glm::vec3>& pixels) { return Image{r.width, r.height, pixels}; }
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+std::string file_safe(const std::string& structure) {
+  std::string s = structure;
+  for (char& c : s)
+    if (c == ':' || c == ',' || c == '(' || c == ')') c = '_';
+  return s;
+}
+
+const RmseRow* RmseStudy::find(const std::string& structure, int start_bounce) const {
+  for (const RmseRow& r : rows)
+    if (r.structure == structure && r.start_bounce == start_bounce) return &r;
+  return nullptr;
+}
+
+Table RmseStudy::summary() const {
+  Table t;
+  t.header = {"structure", "MRays/s", "speed-up vs F-BVH", "MB"};
+  for (int k = 1; k <= settings.bounces; ++k) t.header.push_back("RMSE from bounce " + std::to_string(k));
+  t.rows.push_back({"bvh (reference)", fixed(reference_mrays_per_s, 2), "1.00", fixed(double(reference_bytes) / 1e6, 1)});
+  for (int k = 1; k <= settings.bounces; ++k) t.rows.back().push_back("-");
+  for (const RmseRow& r : rows) {
+    if (r.start_bounce != 1) continue;
+    std::vector<std::string> line = {r.structure};
+    if (!r.refused.empty()) {
+      line.push_back("refused: " + r.refused);
+      while (line.size() < t.header.size()) line.push_back("-");
+    } else {
+      line.push_back(fixed(r.mrays_per_s, 2));
+      line.push_back(fixed(r.mrays_per_s / reference_mrays_per_s, 2));
+      line.push_back(fixed(double(r.bytes) / 1e6, 1));
+      for (int k = 1; k <= settings.bounces; ++k) {
+        const RmseRow* at = find(r.structure, k);
+        line.push_back(at ? rmse_text(at->rmse) : "-");
+      }
+    }
+    t.rows.push_back(line);
+  }
+  return t;
+}
+
+Table RmseStudy::detail() const {
+  Table t;
+  t.header = {"structure", "start_bounce", "rmse", "mrays_per_s", "bytes"};
+  for (int k = 0; k <= settings.bounces; ++k) t.header.push_back("contribution_rmse_bounce_" + std::to_string(k));
+  t.header.push_back("refused");
+  for (const RmseRow& r : rows) {
+    std::vector<std::string> line = {r.structure, std::to_string(r.start_bounce)};
+    const bool ok = r.refused.empty();
+    line.push_back(ok ? fixed(r.rmse, 6) : "");
+    line.push_back(ok ? fixed(r.mrays_per_s, 4) : "");
+    line.push_back(ok ? std::to_string(r.bytes) : "");
+    for (int k = 0; k <= settings.bounces; ++k)
+      line.push_back(ok && size_t(k) < r.contribution_rmse.size() ? fixed(r.contribution_rmse[size_t(k)], 6) : "");
+    line.push_back(r.refused);
+    t.rows.push_back(line);
+  }
+  return t;
+}
+
+nlohmann::json RmseStudy::json() const {
+  nlohmann::json rows_json = nlohmann::json::array();
+  for (const RmseRow& r : rows) {
+    nlohmann::json j{{"structure", r.structure}, {"start_bounce", r.start_bounce}};
+    if (r.refused.empty()) {
+      j["rmse"] = r.rmse;
+      j["mrays_per_s"] = r.mrays_per_s;
+      j["speedup_vs_bvh"] = reference_mrays_per_s > 0.0 ? r.mrays_per_s / reference_mrays_per_s : 0.0;
+      j["bytes"] = r.bytes;
+      j["bytes_ls"] = r.bytes_ls;
+      j["ls_nodes"] = r.ls_nodes;
+      j["build_seconds"] = r.build_seconds;
+      j["contribution_rmse"] = r.contribution_rmse;
+    } else {
+      j["refused"] = r.refused;
+    }
+    rows_json.push_back(j);
+  }
+  return {{"scene", scene},
+          {"device", device},
+          {"width", settings.width},
+          {"height", settings.height},
+          {"spp", settings.spp},
+          {"bounces", settings.bounces},
+          {"seed", settings.seed},
+          {"reference", {{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s}, {"bytes", reference_bytes}}},
+          {"rows", rows_json}};
+}
+
+RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, const std::vector<StructureSpec>& structures,
+                         const ImageSettings& settings, const std::string& out_dir, float heatmap_max, const Log& log,
+                         bool release_structures) {
+  RmseStudy study;
+  study.scene = scene;
+  study.device = renderer.device();
+  study.settings = settings;
+  if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
+
+  auto t0 = std::chrono::steady_clock::now();
+  const Reference reference = render_reference(renderer, settings);
+  study.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
+  study.reference_bytes = reference.bytes;
+  log("reference (bvh): " + fixed(seconds_since(t0), 2) + " s, " + fixed(study.reference_mrays_per_s, 2) + " MRays/s");
+  const Image ref_image = as_image(reference.result, reference.result.total);
+  if (!out_dir.empty()) write_png(out_dir + "/reference.png", ref_image, reference.scale);
+
+  const size_t total = structures.size() * size_t(settings.bounces);
+  size_t done = 0;
+  for (const StructureSpec& spec : structures) {
+    std::string refused;
+    RmseRow built;
+    try {
+      const Accel& accel = renderer.structure(spec);
+      built.bytes = accel.bytes_total();
+      built.bytes_ls = accel.bytes_ls();
+      built.ls_nodes = accel.ls_info.ls_nodes;
+      built.build_seconds = accel.build_seconds;
+    } catch (const InputError& e) {
+      refused = e.what();
+      log(spec.name() + ": refused: " + refused);
+    }
+    for (int k = 1; k <= settings.bounces; ++k) {
+      RmseRow row = built;
+      row.structure = spec.name();
+      row.start_bounce = k;
+      ++done;
+      if (!refused.empty()) {
+        row.refused = refused;
+        study.rows.push_back(row);
+        continue;
+      }
+      t0 = std::chrono::steady_clock::now();
+      const Measured m = measure(renderer, schedule_from(spec, k), settings, reference);
+      row.rmse = m.rmse;
+      row.contribution_rmse = m.contribution_rmse;
+      row.mrays_per_s = m.mrays_per_s;
+      study.rows.push_back(row);
+      log("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + row.structure + " from bounce " +
+          std::to_string(k) + ": RMSE " + rmse_text(row.rmse) + ", " + fixed(row.mrays_per_s, 2) + " MRays/s, " +
+          fixed(seconds_since(t0), 2) + " s");
+      if (!out_dir.empty())
+        write_error_images(out_dir + "/" + file_safe(row.structure) + "_from_bounce_" + std::to_string(k),
+                           ref_image, as_image(m.result, m.result.total), reference.scale, heatmap_max);
+    }
+    if (release_structures) renderer.release(spec);
+  }
+  return study;
+}
+
+void write_rmse_study(const std::string& dir, const RmseStudy& study) {
+  std::filesystem::create_directories(dir);
+  write_text_file(dir + "/rmse.md", study.summary().markdown());
+  write_text_file(dir + "/rmse.csv", study.detail().csv());
+  write_text_file(dir + "/rmse.json", study.json().dump(2) + "\n");
+}
+
+}  // namespace ls

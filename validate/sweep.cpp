@@ -1,0 +1,192 @@
+#include "sweep.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+namespace ls {
+
+namespace {
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) parts.push_back(item);
+  if (parts.empty() || text.empty() || text.back() == ',') throw InputError("empty item in list '" + text + "'");
+  return parts;
+}
+
+}  // namespace
+
+std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int lo, int hi) {
+  std::vector<int> out;
+  for (const std::string& item : split(text)) {
+    size_t used = 0;
+    long v = 0;
+    try {
+      v = std::stol(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || v < lo || v > hi)
+      throw InputError(flag + " " + text + ": '" + item + "' is not an integer in [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    out.push_back(int(v));
+  }
+  return out;
+}
+
+std::vector<float> parse_angle_list(const std::string& text) {
+  std::vector<float> out;
+  for (const std::string& item : split(text)) {
+    size_t used = 0;
+    double v = NAN;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !(v >= 0.0 && v <= 90.0))
+      throw InputError("--angles " + text + ": '" + item + "' is not an angle in [0, 90] degrees");
+    out.push_back(float(v));
+  }
+  return out;
+}
+
+std::vector<StructureKind> parse_families(const std::string& text) {
+  std::vector<StructureKind> out;
+  for (const std::string& item : split(text)) {
+    if (item == "f-ls") out.push_back(StructureKind::FlatLs);
+    else if (item == "2l-ls") out.push_back(StructureKind::TwoLevelLs);
+    else throw InputError("--families " + text + ": '" + item + "' is neither f-ls nor 2l-ls");
+  }
+  return out;
+}
+
+void mark_pareto(std::vector<SweepPoint>& points) {
+  for (SweepPoint& p : points) {
+    p.pareto = p.refused.empty();
+    for (const SweepPoint& q : points) {
+      if (&q == &p || !q.refused.empty() || !p.pareto) continue;
+      const bool as_good = q.mrays_per_s >= p.mrays_per_s && q.rmse <= p.rmse;
+      const bool better = q.mrays_per_s > p.mrays_per_s || q.rmse < p.rmse;
+      if (as_good && better) p.pareto = false;
+    }
+  }
+}
+
+Table Sweep::table() const {
+  Table t;
+  t.header = {"structure", "depth", "subdivision", "angle", "rmse", "mrays_per_s", "speedup_vs_bvh", "bytes",
+              "bytes_ls", "ls_nodes", "build_seconds", "pareto", "refused"};
+  for (const SweepPoint& p : points) {
+    const bool ok = p.refused.empty();
+    t.rows.push_back({p.structure, std::to_string(p.depth), std::to_string(p.subdivision), fixed(p.angle, 1),
+                      ok ? fixed(p.rmse, 6) : "", ok ? fixed(p.mrays_per_s, 4) : "", ok ? fixed(p.speedup, 4) : "",
+                      ok ? std::to_string(p.bytes) : "", ok ? std::to_string(p.bytes_ls) : "",
+                      ok ? std::to_string(p.ls_nodes) : "", ok ? fixed(p.build_seconds, 3) : "",
+                      p.pareto ? "1" : "0", p.refused});
+  }
+  return t;
+}
+
+nlohmann::json Sweep::json() const {
+  nlohmann::json pts = nlohmann::json::array();
+  for (const SweepPoint& p : points) {
+    nlohmann::json j{{"structure", p.structure}, {"depth", p.depth}, {"subdivision", p.subdivision},
+                     {"angle", p.angle}, {"pareto", p.pareto}};
+    if (p.refused.empty()) {
+      j.update({{"rmse", p.rmse}, {"mrays_per_s", p.mrays_per_s}, {"speedup_vs_bvh", p.speedup}, {"bytes", p.bytes},
+                {"bytes_ls", p.bytes_ls}, {"ls_nodes", p.ls_nodes}, {"build_seconds", p.build_seconds}});
+    } else {
+      j["refused"] = p.refused;
+    }
+    pts.push_back(j);
+  }
+  return {{"scene", scene},
+          {"device", device},
+          {"width", settings.width},
+          {"height", settings.height},
+          {"spp", settings.spp},
+          {"bounces", settings.bounces},
+          {"start_bounce", start_bounce},
+          {"reference", {{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s}, {"bytes", reference_bytes}}},
+          {"points", pts}};
+}
+
+Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings,
+                const LsOptions& base_options, const Log& log) {
+  if (grid.start_bounce < 1 || grid.start_bounce > settings.bounces)
+    throw InputError("--start-bounce " + std::to_string(grid.start_bounce) + " must be in [1, --bounces " +
+                     std::to_string(settings.bounces) + "]");
+  Sweep sweep;
+  sweep.scene = scene;
+  sweep.device = renderer.device();
+  sweep.settings = settings;
+  sweep.start_bounce = grid.start_bounce;
+  const Reference reference = render_reference(renderer, settings);
+  sweep.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
+  sweep.reference_bytes = reference.bytes;
+  log("reference (bvh): " + fixed(sweep.reference_mrays_per_s, 2) + " MRays/s");
+
+  const size_t total = grid.angles.size() * grid.families.size() * grid.depths.size() * grid.subdivisions.size();
+  size_t done = 0;
+  for (float angle : grid.angles) {
+    LsOptions options = base_options;
+    options.angle_degrees = angle;
+    renderer.set_ls_options(options);
+    for (StructureKind family : grid.families)
+      for (int depth : grid.depths)
+        for (int n : grid.subdivisions) {
+          StructureSpec spec;
+          spec.kind = family;
+          spec.depth = depth;
+          spec.subdivision = n;
+          SweepPoint p;
+          p.structure = spec.name();
+          p.depth = depth;
+          p.subdivision = n;
+          p.angle = angle;
+          ++done;
+          try {
+            const Accel& accel = renderer.structure(spec);
+            p.bytes = accel.bytes_total();
+            p.bytes_ls = accel.bytes_ls();
+            p.ls_nodes = accel.ls_info.ls_nodes;
+            p.build_seconds = accel.build_seconds;
+          } catch (const InputError& e) {
+            p.refused = e.what();
+          }
+          if (p.refused.empty()) {
+            const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), settings, reference);
+            p.rmse = m.rmse;
+            p.mrays_per_s = m.mrays_per_s;
+            p.speedup = sweep.reference_mrays_per_s > 0.0 ? m.mrays_per_s / sweep.reference_mrays_per_s : 0.0;
+            renderer.release(spec);
+          }
+          sweep.points.push_back(p);
+          std::string line = "[";
+          line += std::to_string(done) + "/" + std::to_string(total) + "] ";
+          line += p.structure + " angle " + fixed(angle, 1) + ": ";
+          if (p.refused.empty())
+            line += "RMSE " + rmse_text(p.rmse) + ", " + fixed(p.speedup, 2) + "x F-BVH, " +
+                    fixed(double(p.bytes) / 1e6, 1) + " MB";
+          else
+            line += "refused: " + p.refused;
+          log(line);
+        }
+  }
+  mark_pareto(sweep.points);
+  return sweep;
+}
+
+void write_sweep(const std::string& dir, const Sweep& sweep) {
+  std::filesystem::create_directories(dir);
+  const Table t = sweep.table();
+  write_text_file(dir + "/sweep.csv", t.csv());
+  write_text_file(dir + "/sweep.md", t.markdown());
+  write_text_file(dir + "/sweep.json", sweep.json().dump(2) + "\n");
+}
+
+}  // namespace ls

@@ -1,0 +1,58 @@
+// `linespace-validate sweep`: the speed/accuracy/memory trade-off of F-LS and 2L-LS over integration
+// depth D, subdivision N and the refusal angle on one scene.  Each configuration traces bounces >=
+// start with its Line Space (exact before), against the all-exact reference of the same run.  The
+// data is written first (CSV, JSON); the plot is a separate step (plot_tradeoff.py).
+#pragma once
+
+#include "measure.h"
+#include "rmse_study.h"
+#include "table.h"
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace ls {
+
+struct SweepGrid {
+  std::vector<StructureKind> families = {StructureKind::FlatLs, StructureKind::TwoLevelLs};
+  std::vector<int> depths = {0, 2, 4, 6, 8};
+  std::vector<int> subdivisions = {4, 6, 8};
+  std::vector<float> angles = {45.0f};
+  int start_bounce = 1;
+};
+
+struct SweepPoint {
+  std::string structure;
+  int depth = 0, subdivision = 0;
+  float angle = 0.0f;
+  double rmse = 0.0, mrays_per_s = 0.0, speedup = 0.0, build_seconds = 0.0;
+  size_t bytes = 0, bytes_ls = 0, ls_nodes = 0;
+  bool pareto = false;       // no other point is at least as fast and as accurate, and better in one
+  std::string refused;       // non-empty: not built (the reason)
+};
+
+struct Sweep {
+  std::string scene, device;
+  ImageSettings settings;
+  int start_bounce = 1;
+  double reference_mrays_per_s = 0.0;
+  size_t reference_bytes = 0;
+  std::vector<SweepPoint> points;
+
+  Table table() const;
+  nlohmann::json json() const;
+};
+
+std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int lo, int hi);
+std::vector<float> parse_angle_list(const std::string& text);
+std::vector<StructureKind> parse_families(const std::string& text);
+
+Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings,
+                const LsOptions& base_options, const Log& log);
+void mark_pareto(std::vector<SweepPoint>& points);
+
+// sweep.csv, sweep.json, sweep.md into dir.
+void write_sweep(const std::string& dir, const Sweep& sweep);
+
+}  // namespace ls
