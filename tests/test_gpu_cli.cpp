@@ -107,3 +107,37 @@ TEST_CASE("linespace-gpu build and render report the device and the CPU's sizes"
   for (const char* f : {"total.exr", "bounce_0.exr", "bounce_1.exr", "image.png", "report.json"}) CHECK(fs::exists(out + "/" + f));
   CHECK_FALSE(nlohmann::json::parse(slurp(out + "/report.json")).at("device").get<std::string>().empty());
 }
+
+TEST_CASE("linespace-validate candidates and hits report zero mismatches and exit 0", "[gpu_cli]") {
+  const Run c = run(LINESPACE_VALIDATE, "candidates --scene builtin:generated:600:2:1 --structure 2l-ls:2:6 --ls-min-triangles 0");
+  INFO(c.out << c.err);
+  REQUIRE(c.status == 0);
+  CHECK(c.out.find(" 0 mismatches") != std::string::npos);
+  const Run h = run(LINESPACE_VALIDATE, "hits --scene builtin:cornell --structure f-ls:3:6 --kind random --count 3000 --any-hit");
+  INFO(h.out << h.err);
+  REQUIRE(h.status == 0);
+  CHECK(h.out.find("3000 compared, 0 mismatches") != std::string::npos);
+  for (const char* bad : {"hits --structure octree", "candidates --structure bvh", "candidates --device no-such-device",
+                          "hits --offset 1 2", "hits --rays /nonexistent.rays"}) {
+    const Run r = run(LINESPACE_VALIDATE, bad);
+    INFO(bad << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+  }
+}
+
+TEST_CASE("linespace-validate rmse on the GPU gives the CPU's RMSE", "[gpu_cli]") {
+  const std::string args = "rmse --size 24x16 --spp 1 --bounces 2 --structures f-ls:3:6,2l-ls:2:6 --out ";
+  REQUIRE(run(LINESPACE_VALIDATE, args + temp("rmse_cpu").string() + " --device cpu").status == 0);
+  const Run g = run(LINESPACE_VALIDATE, args + temp("rmse_gpu").string() + " --device gpu");
+  INFO(g.err);
+  REQUIRE(g.status == 0);
+  const auto cpu = nlohmann::json::parse(slurp(temp("rmse_cpu") / "rmse.json")).at("rows");
+  const auto gpu = nlohmann::json::parse(slurp(temp("rmse_gpu") / "rmse.json")).at("rows");
+  REQUIRE(cpu.size() == gpu.size());
+  REQUIRE(cpu.size() >= 4u);
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    CHECK(cpu[i].at("structure") == gpu[i].at("structure"));
+    CHECK(cpu[i].at("rmse") == gpu[i].at("rmse"));  // the same images, so exactly the same error
+  }
+}

@@ -136,7 +136,11 @@ Scene command_scene(const CrossCheckCommand& c) {
 
 std::string label(const CrossCheckCommand& c, const gpu::VulkanContext& context) {
   std::string s = c.scene + " " + c.structure;
-  if (c.scale != 1.0f) s += " scale " + std::to_string(c.scale);
+  if (c.scale != 1.0f) {
+    char text[32];
+    std::snprintf(text, sizeof(text), " scale %g", double(c.scale));
+    s += text;
+  }
   if (c.offset[0] != 0.0f || c.offset[1] != 0.0f || c.offset[2] != 0.0f) s += " offset";
   return s + " on " + context.description();
 }
