@@ -72,12 +72,12 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   precise vec3 e2 = vec3(tri.v2) - p0;
   int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
   precise vec3 n = cross(scale_pow2(e1, ke), scale_pow2(e2, ke));
-  precise float denom = dot(dir, n);
-  if (denom == 0.0f || dot(n, n) == 0.0f) {
+  precise float denom = dot_in_order(dir, n);
+  if (denom == 0.0f || dot_in_order(n, n) == 0.0f) {
     ls_counters.refused_parallel += 1u;
     return LS_FALLBACK;
   }
-  precise float t = dot(p0 - origin, n) / denom;
+  precise float t = dot_in_order(p0 - origin, n) / denom;
   if (!(t >= tmin)) {
     ls_counters.refused_behind += 1u;
     return LS_FALLBACK;
@@ -88,16 +88,16 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   }
   // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
   precise vec3 q = origin + dir * t - p0;
-  precise float nn = dot(n, n);
-  precise float b1 = dot(cross(scale_pow2(q, ke), scale_pow2(e2, ke)), n) / nn;
-  precise float b2 = dot(cross(scale_pow2(e1, ke), scale_pow2(q, ke)), n) / nn;
+  precise float nn = dot_in_order(n, n);
+  precise float b1 = dot_in_order(cross(scale_pow2(q, ke), scale_pow2(e2, ke)), n) / nn;
+  precise float b2 = dot_in_order(cross(scale_pow2(e1, ke), scale_pow2(q, ke)), n) / nn;
   precise float b0 = 1.0f - b1 - b2;
   uvec4 packed = tri_normals[prim];
   precise vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
-  precise float c = dot(dir, ne);
-  precise float ne2 = dot(ne, ne);
+  precise float c = dot_in_order(dir, ne);
+  precise float ne2 = dot_in_order(ne, ne);
   precise float lhs = c * c;
-  precise float rhs = ls_cos2 * dot(dir, dir) * ne2;
+  precise float rhs = ls_cos2 * dot_in_order(dir, dir) * ne2;
   if (ne2 == 0.0f || lhs < rhs) {
     ls_counters.refused_angle += 1u;
     return LS_FALLBACK;
