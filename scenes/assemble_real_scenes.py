@@ -617,7 +617,7 @@ def layout_room(pieces, meshes):
         row_depth = max(row_depth, d)
     rows.append((z, row))
     z += row_depth + GAP
-    depth = z + max(2.0, 0.45 * width)  # free floor in front, for the camera
+    depth = z + max(2.0, 0.35 * width)  # free floor in front, for the camera
 
     placements, where = [], {}
     for z_back, row in rows:
