@@ -16,7 +16,6 @@ import argparse
 import array
 import glob
 import hashlib
-import io
 import json
 import math
 import os
@@ -45,8 +44,10 @@ MAX_ALBEDO = 0.9  # keeps every surface below perfect reflection, so indirect li
 
 # ---------------------------------------------------------------------------------------------------
 # The scenes.  Targets are the paper's Table 2 (objects = unique meshes = second-level BVHs; triangles
-# in world space).  Models were chosen once, by theme and so that the counts land near the targets;
-# `room` objects (floor, ceiling, 4 walls, light quads) are added by the assembler.
+# in world space).  The models were picked once, offline, from the catalogs' theme categories: a few
+# must-haves per room, then greedily the themed model closest to the triangles still missing per slot.
+# Comments give the catalog's name, category and the model's triangles.  The 7 room objects (floor,
+# ceiling, 4 walls, one light quad mesh) are added by the assembler.
 # ---------------------------------------------------------------------------------------------------
 
 SCENES = {
@@ -219,7 +220,8 @@ SCENES = {
             'Blend Swap CC-BY#officeTable',  # Desk, Office, 4190
         ],
     },
-    # SALLE-DE-BAIN-like: bathroom fixtures plus dense plants and sofas (the catalog has too few dense bathroom models).
+    # SALLE-DE-BAIN-like: bathroom fixtures, then dense plants and sofas (the catalogs hold too few dense
+    # bathroom models for 1.2M triangles).
     "salledebain": {
         "title": "SALLE-DE-BAIN-like", "objects": 39, "triangles": 1231000,
         "furniture": [
