@@ -793,7 +793,12 @@ def assemble(name, recipe, catalogs, out_dir):
         bail("%s: the installed catalogs lack %s" % (name, ", ".join(missing)))
     pieces = [index[i] for i in recipe["furniture"]]
     materials = Materials()
-    meshes = {p["id"]: read_obj(p["catalog"], p, materials, model_rotation(p)) for p in pieces}
+    meshes = {}
+    for p in pieces:
+        try:
+            meshes[p["id"]] = read_obj(p["catalog"], p, materials, model_rotation(p))
+        except (KeyError, ValueError, IndexError) as e:  # a damaged or changed package
+            bail("%s: cannot read %s from %s (%s: %s)" % (name, p["model"], p["catalog"].path, type(e).__name__, e))
     credits = [credit(p) for p in pieces]
 
     placements, width, depth = layout_room(pieces, meshes)
