@@ -11,7 +11,7 @@ case "${1:---small}" in
   *) echo "usage: scripts/assemble-scenes.sh [--small|--all]" >&2; exit 2 ;;
 esac
 
-packages=(sweethome3d-furniture libcgal-demo)
+packages=(python3 sweethome3d-furniture libcgal-demo)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
