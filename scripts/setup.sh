@@ -8,7 +8,8 @@ packages=(build-essential cmake ninja-build pkg-config
   libtbb-dev libxsimd-dev libglm-dev libopenimageio-dev openimageio-tools
   glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
   mesa-vulkan-drivers libvulkan-dev vulkan-tools
-  python3-matplotlib)  # linespace-validate sweep plots (validate/plot_tradeoff.py)
+  python3-matplotlib   # linespace-validate sweep plots (validate/plot_tradeoff.py)
+  python3 sweethome3d-furniture libcgal-demo)  # the real scenes: assembler, sources (scenes/README.md)
 
 missing=()
 for p in "${packages[@]}"; do
