@@ -3,16 +3,16 @@
 namespace ls::gpu {
 
 GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
-    : nodes_(make_buffer(context, accel.nodes)),
-      tris_(make_buffer(context, accel.tris)),
-      tri_ids_(make_buffer(context, accel.tri_ids)),
-      tri_instances_(make_buffer(context, accel.tri_instances)),
-      top_nodes_(make_buffer(context, accel.top_nodes)),
-      instances_(make_buffer(context, accel.instances)),
-      node_ls_(make_buffer(context, accel.node_ls)),
-      ls_nodes_(make_buffer(context, accel.ls_nodes)),
-      ls_candidates_(make_buffer(context, accel.ls_candidates)),
-      tri_normals_(make_buffer(context, accel.tri_normals)) {
+    : nodes_(make_buffer(context, accel.nodes, "nodes")),
+      tris_(make_buffer(context, accel.tris, "tris")),
+      tri_ids_(make_buffer(context, accel.tri_ids, "tri_ids")),
+      tri_instances_(make_buffer(context, accel.tri_instances, "tri_instances")),
+      top_nodes_(make_buffer(context, accel.top_nodes, "top_nodes")),
+      instances_(make_buffer(context, accel.instances, "instances")),
+      node_ls_(make_buffer(context, accel.node_ls, "node_ls")),
+      ls_nodes_(make_buffer(context, accel.ls_nodes, "ls_nodes")),
+      ls_candidates_(make_buffer(context, accel.ls_candidates, "ls_candidates")),
+      tri_normals_(make_buffer(context, accel.tri_normals, "tri_normals")) {
   const lsk::TraceContext c = accel.context();  // the CPU's parameters, so both sides agree
   params_.ls_enabled = c.ls_enabled;
   params_.ls_n = c.ls_n;

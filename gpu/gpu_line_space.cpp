@@ -24,7 +24,7 @@ void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearch
     const size_t limit = std::min<size_t>(kBatchBytes, context.limits().maxStorageBufferRange);
     const size_t batch = std::max<size_t>(1, std::min<size_t>({limit / bytes_per_node, ls_count, context.limits().maxComputeWorkGroupCount[1]}));
     GpuAccel gpu(context, accel);  // the candidates are not read by the search
-    Buffer prims(context, batch * bytes_per_node);
+    Buffer prims(context, batch * bytes_per_node, "search results");
     ComputePipeline pipeline(context, spirv_ls_candidates(), 11, sizeof(ShaderParams));
     KernelTimer timer(context);
     std::vector<const Buffer*> bindings = gpu.bindings();

@@ -16,8 +16,8 @@ GpuTracer::GpuTracer(const VulkanContext& context)
 
 void GpuTracer::set_rays(const std::vector<lsk::Ray>& rays) {
   if (rays.size() > UINT32_MAX / 2) throw InputError("too many rays for one GPU trace");
-  rays_ = make_buffer(context_, rays);
-  hits_ = Buffer(context_, rays.size() * sizeof(lsk::Hit));
+  rays_ = make_buffer(context_, rays, "rays");
+  hits_ = Buffer(context_, rays.size() * sizeof(lsk::Hit), "hits");
   count_ = uint32_t(rays.size());
 }
 

@@ -8,11 +8,17 @@
 
 namespace ls::gpu {
 
-Buffer::Buffer(const VulkanContext& context, size_t bytes) : device_(context.device()), size_(std::max<size_t>(bytes, 16)) {
-  if (size_ > context.limits().maxStorageBufferRange)
-    throw InputError("a GPU buffer of " + std::to_string(size_ >> 20) + " MiB exceeds the device's maxStorageBufferRange (" +
-                     std::to_string(context.limits().maxStorageBufferRange >> 20) + " MiB) on " + context.info().name +
-                     ": lower N or D, or use a smaller scene");
+Buffer::Buffer(const VulkanContext& context, size_t bytes, const char* name)
+    : device_(context.device()), size_(std::max<size_t>(bytes, 16)) {
+  // Each array is bound whole, so it must fit one storage-buffer range (gpu/README.md, "Limits").
+  if (size_ > context.limits().maxStorageBufferRange) {
+    const std::string what(name);
+    const std::string hint = what == "ls_candidates" || what == "ls_nodes" ? "lower N or D"
+                             : what == "rays" || what == "hits"           ? "trace fewer rays at once"
+                                                                           : "use a two-level structure or a smaller scene";
+    throw InputError("the GPU array '" + what + "' takes " + std::to_string(size_ >> 20) + " MiB, over the maxStorageBufferRange (" +
+                     std::to_string(context.limits().maxStorageBufferRange >> 20) + " MiB) of " + context.info().name + ": " + hint);
+  }
   VkBufferCreateInfo bci{};
   bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   bci.size = size_;

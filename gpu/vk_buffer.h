@@ -15,7 +15,8 @@ namespace ls::gpu {
 class Buffer {
  public:
   Buffer() = default;
-  Buffer(const VulkanContext& context, size_t bytes);
+  // `name` says in the error which array did not fit (e.g. "ls_candidates").
+  Buffer(const VulkanContext& context, size_t bytes, const char* name = "buffer");
   ~Buffer();
   Buffer(Buffer&& other) noexcept;
   Buffer& operator=(Buffer&& other) noexcept;
@@ -40,8 +41,8 @@ class Buffer {
 
 // A buffer holding a copy of `values`.
 template <class T>
-Buffer make_buffer(const VulkanContext& context, const std::vector<T>& values) {
-  Buffer b(context, values.size() * sizeof(T));
+Buffer make_buffer(const VulkanContext& context, const std::vector<T>& values, const char* name = "buffer") {
+  Buffer b(context, values.size() * sizeof(T), name);
   if (!values.empty()) b.upload(values.data(), values.size() * sizeof(T));
   return b;
 }
