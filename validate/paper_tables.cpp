@@ -66,84 +66,10 @@ std::string verdict(int held, int total) {
 
 }  // namespace
 
-PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_options, const std::string& out_dir,
-                      const Log& log) {
-  for (int t : options.tables)
-    if (t < 2 || t > 4) throw InputError("--tables: the paper's tables are 2, 3 and 4 (not " + std::to_string(t) + ")");
-  for (int n : options.subdivisions)
-    if (n != 6 && n != 10) throw InputError("--subdivisions: the paper used N = 6 and N = 10 (not " + std::to_string(n) + ")");
-  const bool renders = options.tables.count(3) || options.tables.count(4);
-  if (renders && options.settings.bounces < 3)
-    throw InputError("--bounces " + std::to_string(options.settings.bounces) + ": Tables 3 and 4 need 3 bounces");
-  if (options.scenes.empty()) throw InputError("--scenes: give at least one scene");
-
-  std::vector<const paper::Config*> configs;
-  for (const paper::Config& c : paper::kConfigs)
-    if (options.subdivisions.count(c.subdivision)) configs.push_back(&c);
-
-  PaperReport report;
-  for (const std::string& scene_spec : options.scenes) {
-    log("== " + scene_spec);
-    const Scene scene = load_scene(scene_spec);
-    auto renderer = make_study_renderer(options.device, scene, accel_options);
-    PaperScene ps;
-    ps.scene = scene_spec;
-    ps.triangles = triangle_count(scene);
-    ps.objects = scene.meshes.size();
-    ps.instances = scene.instances.size();
-    ps.paper_scene = nearest_paper_scene(ps.triangles, ps.objects, ps.instances);
-
-    std::vector<StructureSpec> specs;
-    if (options.tables.count(3)) specs.push_back(parse_structure("2l-bvh"));
-    for (const paper::Config* c : configs) specs.push_back(config_spec(*c));
-    const ImageSettings& settings = options.settings;
-    if (options.tables.count(3)) {
-      const std::string dir = out_dir + "/" + file_safe(std::filesystem::path(scene_spec).filename().string());
-      ps.study = run_rmse_study(*renderer, scene_spec, specs, settings, dir, options.heatmap_max, log, true);
-      write_rmse_study(dir, ps.study);
-    } else if (options.tables.count(2)) {
-      ps.study.scene = scene_spec;
-      ps.study.device = renderer->device();
-      ps.study.settings = settings;
-      for (const StructureSpec& spec : specs) {
-        RmseRow row;
-        row.structure = spec.name();
-        try {
-          const Accel& a = renderer->structure(spec);
-          row.bytes = a.bytes_total();
-          row.bytes_ls = a.bytes_ls();
-          row.ls_nodes = a.ls_info.ls_nodes;
-          row.build_seconds = a.build_seconds;
-        } catch (const InputError& e) {
-          row.refused = e.what();
-        }
-        log(spec.name() + (row.refused.empty() ? ": built in " + fixed(row.build_seconds, 2) + " s" : ": refused"));
-        ps.study.rows.push_back(row);
-        renderer->release(spec);
-      }
-    }
-    if (options.tables.count(4)) {
-      const Reference reference = render_reference(*renderer, settings);
-      for (const paper::ScheduleRow& s : paper::kSchedules) {
-        ScheduleMeasure sm;
-        sm.paper_name = s.paper_name;
-        sm.schedule = s.schedule;
-        try {
-          const Measured m = measure(*renderer, parse_schedule(s.schedule), settings, reference);
-          sm.rmse = m.rmse;
-          sm.mrays_per_s = m.mrays_per_s;
-          sm.bytes = m.bytes;
-        } catch (const InputError& e) {
-          sm.refused = e.what();
-        }
-        log("Table 4 " + sm.schedule + ": " +
-            (sm.refused.empty() ? "RMSE " + rmse_text(sm.rmse) + ", " + fixed(sm.mrays_per_s, 2) + " MRays/s"
-                                : "refused: " + sm.refused));
-        ps.table4.push_back(sm);
-      }
-    }
-    report.scenes.push_back(std::move(ps));
-  }
+// The tables, ours beside the paper's, and the claims, from the scenes measured so far; writes
+// paper.md and paper.json.
+static void compose(const PaperOptions& options, const std::vector<const paper::Config*>& configs, const std::string& out_dir,
+             PaperReport& report) {
 
   // ---- the tables, ours beside the paper's ----
   std::string md;
@@ -384,6 +310,87 @@ PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_opt
   std::filesystem::create_directories(out_dir);
   write_text_file(out_dir + "/paper.md", md);
   write_text_file(out_dir + "/paper.json", report.json.dump(2) + "\n");
+}
+
+PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_options, const std::string& out_dir,
+                      const Log& log) {
+  for (int t : options.tables)
+    if (t < 2 || t > 4) throw InputError("--tables: the paper's tables are 2, 3 and 4 (not " + std::to_string(t) + ")");
+  for (int n : options.subdivisions)
+    if (n != 6 && n != 10) throw InputError("--subdivisions: the paper used N = 6 and N = 10 (not " + std::to_string(n) + ")");
+  const bool renders = options.tables.count(3) || options.tables.count(4);
+  if (renders && options.settings.bounces < 3)
+    throw InputError("--bounces " + std::to_string(options.settings.bounces) + ": Tables 3 and 4 need 3 bounces");
+  if (options.scenes.empty()) throw InputError("--scenes: give at least one scene");
+
+  std::vector<const paper::Config*> configs;
+  for (const paper::Config& c : paper::kConfigs)
+    if (options.subdivisions.count(c.subdivision)) configs.push_back(&c);
+
+  PaperReport report;
+  for (const std::string& scene_spec : options.scenes) {
+    log("== " + scene_spec);
+    const Scene scene = load_scene(scene_spec);
+    auto renderer = make_study_renderer(options.device, scene, accel_options);
+    PaperScene ps;
+    ps.scene = scene_spec;
+    ps.triangles = triangle_count(scene);
+    ps.objects = scene.meshes.size();
+    ps.instances = scene.instances.size();
+    ps.paper_scene = nearest_paper_scene(ps.triangles, ps.objects, ps.instances);
+
+    std::vector<StructureSpec> specs;
+    if (options.tables.count(3)) specs.push_back(parse_structure("2l-bvh"));
+    for (const paper::Config* c : configs) specs.push_back(config_spec(*c));
+    const ImageSettings& settings = options.settings;
+    if (options.tables.count(3)) {
+      const std::string dir = out_dir + "/" + file_safe(std::filesystem::path(scene_spec).filename().string());
+      ps.study = run_rmse_study(*renderer, scene_spec, specs, settings, dir, options.heatmap_max, log, true);
+      write_rmse_study(dir, ps.study);
+    } else if (options.tables.count(2)) {
+      ps.study.scene = scene_spec;
+      ps.study.device = renderer->device();
+      ps.study.settings = settings;
+      for (const StructureSpec& spec : specs) {
+        RmseRow row;
+        row.structure = spec.name();
+        try {
+          const Accel& a = renderer->structure(spec);
+          row.bytes = a.bytes_total();
+          row.bytes_ls = a.bytes_ls();
+          row.ls_nodes = a.ls_info.ls_nodes;
+          row.build_seconds = a.build_seconds;
+        } catch (const InputError& e) {
+          row.refused = e.what();
+        }
+        log(spec.name() + (row.refused.empty() ? ": built in " + fixed(row.build_seconds, 2) + " s" : ": refused"));
+        ps.study.rows.push_back(row);
+        renderer->release(spec);
+      }
+    }
+    if (options.tables.count(4)) {
+      const Reference reference = render_reference(*renderer, settings);
+      for (const paper::ScheduleRow& s : paper::kSchedules) {
+        ScheduleMeasure sm;
+        sm.paper_name = s.paper_name;
+        sm.schedule = s.schedule;
+        try {
+          const Measured m = measure(*renderer, parse_schedule(s.schedule), settings, reference);
+          sm.rmse = m.rmse;
+          sm.mrays_per_s = m.mrays_per_s;
+          sm.bytes = m.bytes;
+        } catch (const InputError& e) {
+          sm.refused = e.what();
+        }
+        log("Table 4 " + sm.schedule + ": " +
+            (sm.refused.empty() ? "RMSE " + rmse_text(sm.rmse) + ", " + fixed(sm.mrays_per_s, 2) + " MRays/s"
+                                : "refused: " + sm.refused));
+        ps.table4.push_back(sm);
+      }
+    }
+    report.scenes.push_back(std::move(ps));
+    compose(options, configs, out_dir, report);  // written after every scene: long runs leave results early
+  }
   return report;
 }
 

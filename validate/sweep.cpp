@@ -64,9 +64,10 @@ std::vector<StructureKind> parse_families(const std::string& text) {
   return out;
 }
 
-void mark_pareto(std::vector<SweepPoint>& points) {
+void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s) {
   for (SweepPoint& p : points) {
-    p.pareto = p.refused.empty();
+    p.pareto = p.refused.empty() &&
+               !(reference_mrays_per_s >= p.mrays_per_s && (reference_mrays_per_s > p.mrays_per_s || p.rmse > 0.0));
     for (const SweepPoint& q : points) {
       if (&q == &p || !q.refused.empty() || !p.pareto) continue;
       const bool as_good = q.mrays_per_s >= p.mrays_per_s && q.rmse <= p.rmse;
@@ -177,7 +178,7 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
           log(line);
         }
   }
-  mark_pareto(sweep.points);
+  mark_pareto(sweep.points, sweep.reference_mrays_per_s);
   return sweep;
 }
 

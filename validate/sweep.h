@@ -28,7 +28,7 @@ struct SweepPoint {
   float angle = 0.0f;
   double rmse = 0.0, mrays_per_s = 0.0, speedup = 0.0, build_seconds = 0.0;
   size_t bytes = 0, bytes_ls = 0, ls_nodes = 0;
-  bool pareto = false;       // no other point is at least as fast and as accurate, and better in one
+  bool pareto = false;       // no other point (nor the exact F-BVH) is at least as fast and as accurate, and better in one
   std::string refused;       // non-empty: not built (the reason)
 };
 
@@ -50,7 +50,8 @@ std::vector<StructureKind> parse_families(const std::string& text);
 
 Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings,
                 const LsOptions& base_options, const Log& log);
-void mark_pareto(std::vector<SweepPoint>& points);
+// The exact reference (RMSE 0 at reference_mrays_per_s) takes part: a point it dominates is off the front.
+void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s);
 
 // sweep.csv, sweep.json, sweep.md into dir.
 void write_sweep(const std::string& dir, const Sweep& sweep);
