@@ -1,8 +1,5 @@
 #include "path_tracer.h"
 
-#include "kernels/camera.h"
-#include "kernels/offset_ray.h"
-#include "kernels/rng.h"
 #include "kernels/sampling.h"
 #include "surface.h"
 
@@ -13,72 +10,46 @@
 #include <cmath>
 
 namespace ls {
+
+LightSet::LightSet(const Scene& scene, const SurfaceLookup& surfaces) {
+  std::vector<double> power;
+  for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+    const Mesh& mesh = scene.meshes[scene.instances[i].mesh];
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::vec3 e = scene.materials[mesh.materials[t]].emission;
+      if (lsk::luminance(e) <= 0.0f) continue;
+      lsk::ShadeLight l{};
+      surfaces.world_triangle(i, t, l.a, l.b, l.c);
+      l.emission = e;
+      l.area = 0.5f * glm::length(glm::cross(l.b - l.a, l.c - l.a));
+      if (!(l.area > 0.0f) || !std::isfinite(l.area)) continue;
+      lights.push_back(l);
+      power.push_back(double(l.area) * lsk::luminance(e));
+    }
+  }
+  double sum = 0.0;
+  for (double p : power) sum += p;
+  double run = 0.0;
+  for (double p : power) {
+    run += p;
+    cdf.push_back(float(run / sum));
+  }
+  if (!cdf.empty()) cdf.back() = 1.0f;
+  total_power = float(sum);
+}
+
+lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& lights, const RenderOptions& options) {
+  lsk::ShadeContext c = surfaces.context();
+  c.lights = lights.lights.data();
+  c.light_cdf = lights.cdf.data();
+  c.shade.seed = options.seed;
+  c.shade.light_count = uint32_t(lights.lights.size());
+  c.shade.total_power = lights.total_power;
+  c.shade.bounces = uint32_t(std::max(0, options.bounces));
+  return c;
+}
+
 namespace {
-
-// Random dimensions used at each bounce.
-enum Dim : uint32_t { kPixelX = 0, kPixelY = 1, kLightPick = 2, kLightU = 3, kLightV = 4, kBsdfU = 5, kBsdfV = 6 };
-
-struct Light {
-  glm::vec3 a, b, c;
-  glm::vec3 emission;
-  float area;
-};
-
-// Emissive world triangles with a CDF by power (area x luminance of emission).
-struct LightSet {
-  std::vector<Light> lights;
-  std::vector<float> cdf;  // inclusive, last == 1
-  float total_power = 0.0f;
-
-  LightSet(const Scene& scene, const SurfaceLookup& surfaces) {
-    std::vector<double> power;
-    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
-      const Mesh& mesh = scene.meshes[scene.instances[i].mesh];
-      for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-        const glm::vec3 e = scene.materials[mesh.materials[t]].emission;
-        if (lsk::luminance(e) <= 0.0f) continue;
-        Light l;
-        surfaces.world_triangle(i, t, l.a, l.b, l.c);
-        l.emission = e;
-        l.area = 0.5f * glm::length(glm::cross(l.b - l.a, l.c - l.a));
-        if (!(l.area > 0.0f) || !std::isfinite(l.area)) continue;
-        lights.push_back(l);
-        power.push_back(double(l.area) * lsk::luminance(e));
-      }
-    }
-    double sum = 0.0;
-    for (double p : power) sum += p;
-    double run = 0.0;
-    for (double p : power) {
-      run += p;
-      cdf.push_back(float(run / sum));
-    }
-    if (!cdf.empty()) cdf.back() = 1.0f;
-    total_power = float(sum);
-  }
-  bool empty() const { return lights.empty(); }
-  size_t pick(float u) const {
-    return size_t(std::min<std::ptrdiff_t>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin(),
-                                           std::ptrdiff_t(cdf.size()) - 1));
-  }
-  // Density, per unit area, of sampling a point on an emissive triangle of emission e.
-  float area_pdf(const glm::vec3& e) const { return total_power > 0.0f ? lsk::luminance(e) / total_power : 0.0f; }
-};
-
-struct PathState {
-  lsk::Ray ray;
-  glm::vec3 throughput{1.0f};
-  float bsdf_pdf = 0.0f;  // solid-angle density of the direction that made `ray` (MIS)
-  bool alive = false;
-};
-
-struct ShadowQuery {
-  lsk::Ray ray;
-  glm::vec3 contribution{0.0f};
-  uint32_t pixel = 0;
-};
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 template <typename F>
 double timed(F&& f) {
@@ -123,7 +94,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   const SurfaceLookup surfaces(scene);
   const LightSet lights(scene, surfaces);
   const lsk::CameraFrame cam = camera_frame(scene.camera, options.width, options.height);
-  const float scale = surfaces.scene_scale();
+  lsk::ShadeContext shading = shade_context(surfaces, lights, options);  // read only; its kernels are non-const members
 
   std::vector<const Accel*> accel(size_t(bounces) + 1);
   RenderResult result;
@@ -139,25 +110,16 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
     result.bounces[size_t(k)].structure = name;
   }
 
-  std::vector<PathState> paths(pixels);
+  std::vector<lsk::PathState> paths(pixels);
   std::vector<lsk::Hit> hits(pixels);
   std::vector<uint32_t> active;
   std::vector<lsk::Ray> batch;
   std::vector<lsk::Hit> batch_hits;
-  std::vector<ShadowQuery> shadows(pixels);
-  std::vector<char> has_shadow(pixels);
   std::vector<uint32_t> dropped(pixels, 0);
 
   for (int s = 0; s < options.spp; ++s) {
     const uint32_t sample = uint32_t(s);
-    tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) {
-      const float x = float(p % options.width) + lsk::random01(options.seed, p, sample, 0, kPixelX);
-      const float y = float(p / options.width) + lsk::random01(options.seed, p, sample, 0, kPixelY);
-      paths[p].ray = lsk::camera_ray(cam, x, y);
-      paths[p].throughput = glm::vec3(1.0f);
-      paths[p].bsdf_pdf = 0.0f;
-      paths[p].alive = true;
-    });
+    tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) { shading.start_path(p, sample, cam, paths[p]); });
 
     for (int k = 0; k <= bounces; ++k) {
       const uint32_t bounce = uint32_t(k);
@@ -180,96 +142,23 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       };
 
       // Trace the extension rays of this bounce (the camera rays at bounce 0).
-      stats.extension_rays += trace_selected([&](uint32_t p) { return paths[p].alive; },
+      stats.extension_rays += trace_selected([&](uint32_t p) { return paths[p].alive != 0; },
                                              [&](uint32_t p) { return paths[p].ray; }, false);
       if (active.empty()) break;
 
       // Shade: emission found, a light sample for next-event estimation, the next direction.
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         const uint32_t p = active[i];
-        PathState& path = paths[p];
-        const lsk::Hit& hit = batch_hits[i];
-        has_shadow[p] = 0;
-        auto add = [&](const glm::vec3& c) {
-          if (finite(c)) image[p] += c;
-          else ++dropped[p];
-        };
-        if (hit.triangle == lsk::LS_INVALID) {
-          add(path.throughput * scene.background);
-          path.alive = false;
-          return;
-        }
-        const SurfacePoint sp = surfaces.at(hit, path.ray.dir);
-        const Material& mat = scene.materials[sp.material];
-        if (lsk::luminance(mat.emission) > 0.0f) {
-          float weight = 1.0f;
-          if (k > 0) {
-            const float dist = hit.t * glm::length(path.ray.dir);
-            const float cos_l = std::fabs(glm::dot(sp.geometric_normal, glm::normalize(path.ray.dir)));
-            const float light_pdf = cos_l > 0.0f ? lights.area_pdf(mat.emission) * dist * dist / cos_l : 0.0f;
-            weight = lsk::power_heuristic(path.bsdf_pdf, light_pdf);
-          }
-          add(path.throughput * mat.emission * weight);
-        }
-        const glm::vec3 n = sp.geometric_normal;
-        const glm::vec3 origin = lsk::offset_ray_origin(sp.position, n, scale);
-        if (!lights.empty()) {
-          const Light& l = lights.lights[lights.pick(lsk::random01(options.seed, p, sample, bounce, kLightPick))];
-          const glm::vec3 q = lsk::sample_triangle(l.a, l.b, l.c, lsk::random01(options.seed, p, sample, bounce, kLightU),
-                                                   lsk::random01(options.seed, p, sample, bounce, kLightV));
-          glm::vec3 nl = glm::cross(l.b - l.a, l.c - l.a);
-          nl = glm::normalize(nl);
-          if (glm::dot(nl, origin - q) < 0.0f) nl = -nl;
-          const glm::vec3 target = lsk::offset_ray_origin(q, nl, scale);
-          const glm::vec3 d = target - origin;
-          const float dist2 = glm::dot(d, d);
-          const glm::vec3 wi = d / std::sqrt(dist2);
-          const float cos_s = glm::dot(n, wi);
-          const float cos_l = glm::dot(nl, -wi);
-          if (cos_s > 0.0f && cos_l > 0.0f && dist2 > 0.0f) {
-            const float light_pdf = lights.area_pdf(l.emission) * dist2 / cos_l;
-            const float bsdf_pdf = cos_s / lsk::LS_PI;
-            // The last bounce traces no further segment to find this light by BSDF sampling, so its
-            // light sample carries the whole weight.
-            const float weight = k == bounces ? 1.0f : lsk::power_heuristic(light_pdf, bsdf_pdf);
-            ShadowQuery& sq = shadows[p];
-            sq.ray.origin = origin;
-            sq.ray.dir = d;
-            sq.ray.tmin = 0.0f;
-            sq.ray.tmax = 1.0f;
-            sq.contribution = path.throughput * (mat.albedo / lsk::LS_PI) * l.emission * (cos_s * weight / light_pdf);
-            sq.pixel = p;
-            has_shadow[p] = 1;
-          }
-        }
-        if (k == bounces) {
-          path.alive = false;
-          return;
-        }
-        const glm::vec3 dir = lsk::sample_cosine_hemisphere(n, lsk::random01(options.seed, p, sample, bounce, kBsdfU),
-                                                            lsk::random01(options.seed, p, sample, bounce, kBsdfV));
-        const float cos_o = glm::dot(n, dir);
-        if (!(cos_o > 0.0f)) {
-          path.alive = false;
-          return;
-        }
-        path.ray.origin = origin;
-        path.ray.dir = dir;
-        path.ray.tmin = 0.0f;
-        path.ray.tmax = lsk::ls_infinity();
-        path.bsdf_pdf = cos_o / lsk::LS_PI;
-        path.throughput *= mat.albedo;  // albedo/pi * cos / (cos/pi)
-        if (!(lsk::luminance(path.throughput) > 0.0f)) path.alive = false;
+        shading.shade_path(p, sample, bounce, batch_hits[i], paths[p], image[p], dropped[p]);
       });
 
       // Trace this bounce's shadow rays (any hit) and add the light they let through.
-      stats.shadow_rays += trace_selected([&](uint32_t p) { return has_shadow[p] != 0; },
-                                          [&](uint32_t p) { return shadows[p].ray; }, true);
+      stats.shadow_rays += trace_selected([&](uint32_t p) { return paths[p].has_shadow != 0; },
+                                          [&](uint32_t p) { return paths[p].shadow_ray; }, true);
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
-        const ShadowQuery& sq = shadows[active[i]];
-        if (finite(sq.contribution)) image[sq.pixel] += sq.contribution;
-        else ++dropped[sq.pixel];
+        const uint32_t p = active[i];
+        shading.add_shadow_light(paths[p], image[p], dropped[p]);
       });
     }
     if (progress) progress(s + 1, options.spp);

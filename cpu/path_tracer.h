@@ -17,7 +17,9 @@
 
 #include "accel.h"
 #include "scene.h"
+#include "shade_context.h"
 #include "structure_name.h"
+#include "surface.h"
 
 #include <functional>
 #include <map>
@@ -61,6 +63,18 @@ using Progress = std::function<void(int done, int total)>;
 // Traces one batch of rays with a structure, like trace_rays(); the GPU port passes its own.
 using BatchTracer = std::function<void(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                                        lsk::LsCounters* counters)>;
+
+// Emissive world triangles with a CDF by power (area x luminance of emission), as the shading
+// kernel's arrays (common/kernels/shade_path.h).
+struct LightSet {
+  std::vector<lsk::ShadeLight> lights;
+  std::vector<float> cdf;  // inclusive, last == 1
+  float total_power = 0.0f;
+  LightSet(const Scene& scene, const SurfaceLookup& surfaces);
+};
+
+// The shading kernel's context for a render: the surfaces' arrays, the lights and the options.
+lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& lights, const RenderOptions& options);
 
 // structures: built structures keyed by canonical name; every schedule entry must be present.
 // tracer: where the batches are traced (empty: trace_rays on all CPU threads).

@@ -8,8 +8,43 @@
 namespace ls {
 
 SurfaceLookup::SurfaceLookup(const Scene& scene) : scene_(scene) {
-  for (const Instance& inst : scene.instances)
-    normal_matrix_.push_back(glm::transpose(glm::inverse(glm::mat3(inst.object_to_world))));
+  std::vector<uint32_t> first_vertex, first_triangle;
+  for (const Mesh& mesh : scene.meshes) {
+    first_vertex.push_back(uint32_t(vertices_.size()));
+    first_triangle.push_back(uint32_t(triangles_.size()));
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      lsk::ShadeVertex sv{};
+      sv.position = mesh.positions[v];
+      sv.normal = mesh.normals[v];
+      vertices_.push_back(sv);
+    }
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      lsk::ShadeTriangle st{};
+      st.idx = mesh.triangles[t] + glm::uvec3(first_vertex.back());
+      st.material = mesh.materials[t];
+      triangles_.push_back(st);
+    }
+  }
+  for (const Instance& inst : scene.instances) {
+    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(inst.object_to_world)));
+    lsk::ShadeInstance si{};
+    si.col0 = glm::vec3(inst.object_to_world[0]);
+    si.col1 = glm::vec3(inst.object_to_world[1]);
+    si.col2 = glm::vec3(inst.object_to_world[2]);
+    si.col3 = glm::vec3(inst.object_to_world[3]);
+    si.ncol0 = normal_matrix[0];
+    si.ncol1 = normal_matrix[1];
+    si.ncol2 = normal_matrix[2];
+    si.first_vertex = first_vertex[inst.mesh];
+    si.first_triangle = first_triangle[inst.mesh];
+    instances_.push_back(si);
+  }
+  for (const Material& m : scene.materials) {
+    lsk::ShadeMaterial sm{};
+    sm.albedo = m.albedo;
+    sm.emission = m.emission;
+    materials_.push_back(sm);
+  }
   const Bounds b = world_bounds(scene);
   const glm::vec3 m3 = glm::max(glm::abs(b.lo), glm::abs(b.hi));
   const float m = std::max({m3.x, m3.y, m3.z});
@@ -27,30 +62,20 @@ void SurfaceLookup::world_triangle(uint32_t instance, uint32_t triangle, glm::ve
   c = transform_point(inst.object_to_world, mesh.positions[idx.z]);
 }
 
+lsk::ShadeContext SurfaceLookup::context() const {
+  lsk::ShadeContext c;
+  c.shade_instances = instances_.data();
+  c.shade_vertices = vertices_.data();
+  c.shade_triangles = triangles_.data();
+  c.materials = materials_.data();
+  c.shade.background = scene_.background;
+  c.shade.scene_scale = scene_scale_;
+  return c;
+}
+
 SurfacePoint SurfaceLookup::at(const lsk::Hit& hit, const glm::vec3& ray_dir) const {
-  const Instance& inst = scene_.instances[hit.instance];
-  const Mesh& mesh = scene_.meshes[inst.mesh];
-  const glm::uvec3 idx = mesh.triangles[hit.triangle];
-  glm::vec3 a, b, c;
-  world_triangle(hit.instance, hit.triangle, a, b, c);
-  const float w0 = 1.0f - hit.u - hit.v;
   SurfacePoint sp;
-  sp.position = a * w0 + b * hit.u + c * hit.v;
-  // Edges scaled by a power of two first: at 1e20 or 1e-20 a float cross product over- or underflows.
-  glm::vec3 e1 = b - a, e2 = c - a;
-  const int k = lsk::unit_exponent(std::max(lsk::max_abs(e1), lsk::max_abs(e2)));
-  glm::vec3 ng = glm::cross(lsk::scale_pow2(e1, k), lsk::scale_pow2(e2, k));
-  const float len = glm::length(ng);
-  ng = len > 0.0f && std::isfinite(len) ? ng / len : -glm::normalize(ray_dir);
-  if (glm::dot(ng, ray_dir) > 0.0f) ng = -ng;
-  glm::vec3 ns = normal_matrix_[hit.instance] *
-                 (mesh.normals[idx.x] * w0 + mesh.normals[idx.y] * hit.u + mesh.normals[idx.z] * hit.v);
-  const float ns_len = glm::length(ns);
-  ns = ns_len > 0.0f && std::isfinite(ns_len) ? ns / ns_len : ng;
-  if (glm::dot(ns, ng) < 0.0f) ns = -ns;
-  sp.geometric_normal = ng;
-  sp.shading_normal = ns;
-  sp.material = mesh.materials[hit.triangle];
+  context().surface_at(hit, ray_dir, sp.position, sp.geometric_normal, sp.shading_normal, sp.material);
   return sp;
 }
 

@@ -4,6 +4,7 @@
 
 #include "kernels/layouts.h"
 #include "scene.h"
+#include "shade_context.h"
 
 #include <vector>
 
@@ -16,12 +17,19 @@ struct SurfacePoint {
   uint32_t material;
 };
 
-// Per-instance transforms prepared once for shading.
+// The scene's meshes, instances and materials as the std430 arrays of the shading kernel
+// (common/kernels/shade_path.h), prepared once; the lookup itself is the kernel's surface_at.
 class SurfaceLookup {
  public:
   explicit SurfaceLookup(const Scene& scene);
   // hit must be a hit (triangle != LS_INVALID); ray_dir is the direction of the ray that found it.
   SurfacePoint at(const lsk::Hit& hit, const glm::vec3& ray_dir) const;
+  // The kernel's context over these arrays (no lights; ShadeParams with scene_scale and background).
+  lsk::ShadeContext context() const;
+  const std::vector<lsk::ShadeInstance>& shade_instances() const { return instances_; }
+  const std::vector<lsk::ShadeVertex>& shade_vertices() const { return vertices_; }
+  const std::vector<lsk::ShadeTriangle>& shade_triangles() const { return triangles_; }
+  const std::vector<lsk::ShadeMaterial>& shade_materials() const { return materials_; }
   // World-space vertices of a triangle.
   void world_triangle(uint32_t instance, uint32_t triangle, glm::vec3& a, glm::vec3& b, glm::vec3& c) const;
   // A power of two at least the largest absolute world coordinate (the ray-offset scale).
@@ -29,7 +37,10 @@ class SurfaceLookup {
 
  private:
   const Scene& scene_;
-  std::vector<glm::mat3> normal_matrix_;
+  std::vector<lsk::ShadeInstance> instances_;
+  std::vector<lsk::ShadeVertex> vertices_;
+  std::vector<lsk::ShadeTriangle> triangles_;
+  std::vector<lsk::ShadeMaterial> materials_;
   float scene_scale_ = 1.0f;
 };
 

@@ -101,6 +101,86 @@ struct CameraFrame {
   uint height;
 };
 
+
+// The path tracer's shading data (common/kernels/shade_path.h), built once per render by the host.
+// A placed mesh: object-to-world columns (affine: col3 is the translation), the normal matrix's
+// columns (transpose of the inverse of the upper 3x3), and where its vertices and triangles start.
+struct ShadeInstance {
+  vec3 col0;
+  uint first_vertex;
+  vec3 col1;
+  uint first_triangle;
+  vec3 col2;
+  uint pad0;
+  vec3 col3;
+  uint pad1;
+  vec3 ncol0;
+  uint pad2;
+  vec3 ncol1;
+  uint pad3;
+  vec3 ncol2;
+  uint pad4;
+};
+
+// A mesh vertex in object space: position and unit vertex normal.
+struct ShadeVertex {
+  vec3 position;
+  uint pad0;
+  vec3 normal;
+  uint pad1;
+};
+
+// A mesh triangle: absolute indices into the vertices, and its material.
+struct ShadeTriangle {
+  uvec3 idx;
+  uint material;
+};
+
+// A Lambertian material: reflectance and emitted radiance (non-zero: an area light).
+struct ShadeMaterial {
+  vec3 albedo;
+  uint pad0;
+  vec3 emission;
+  uint pad1;
+};
+
+// An emissive world triangle, picked for next-event estimation by the CDF light_cdf[] (by power).
+struct ShadeLight {
+  vec3 a;
+  float area;
+  vec3 b;
+  uint pad0;
+  vec3 c;
+  uint pad1;
+  vec3 emission;
+  uint pad2;
+};
+
+// Per-render constants of the shading kernel.
+struct ShadeParams {
+  vec3 background;    // radiance of rays that leave the scene
+  float scene_scale;  // ray-offset scale (power of two >= largest absolute world coordinate)
+  uint seed;
+  uint light_count;
+  float total_power;  // sum of area x luminance(emission) over the lights
+  uint bounces;       // the last bounce: its light sample takes the full weight, no further segment
+};
+
+// One path of the wavefront (one pixel): the segment to trace, the shadow ray of the current bounce
+// and what it carries, the throughput and the density of the direction that made `ray` (MIS).
+struct PathState {
+  Ray ray;
+  Ray shadow_ray;
+  vec3 throughput;
+  float bsdf_pdf;
+  vec3 shadow_contribution;
+  uint alive;
+  uint has_shadow;
+  uint pad0;
+  uint pad1;
+  uint pad2;
+};
+
 #ifdef __cplusplus
 }  // namespace lsk
 #endif
