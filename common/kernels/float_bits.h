@@ -51,6 +51,23 @@ LS_FN float dot_in_order(IN(vec3) a, IN(vec3) b) {
   return s;
 }
 
+// GLM's cross, length and normalize (v * (1 / sqrt(dot))) spelled out: GLSL's built-ins may be
+// evaluated otherwise (lavapipe's normalize uses an approximate inverse square root).
+LS_FN vec3 cross_in_order(IN(vec3) a, IN(vec3) b) {
+  precise float x = a.y * b.z - b.y * a.z;
+  precise float y = a.z * b.x - b.z * a.x;
+  precise float z = a.x * b.y - b.x * a.y;
+  return vec3(x, y, z);
+}
+
+LS_FN float length_in_order(IN(vec3) v) { return sqrt(dot_in_order(v, v)); }
+
+LS_FN vec3 normalize_in_order(IN(vec3) v) {
+  precise float inv = 1.0f / sqrt(dot_in_order(v, v));
+  precise vec3 r = v * inv;
+  return r;
+}
+
 LS_FN float max_abs(IN(vec3) v) { return max(max(abs(v.x), abs(v.y)), abs(v.z)); }
 
 #ifdef __cplusplus

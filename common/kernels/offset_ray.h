@@ -19,7 +19,8 @@ LS_FN float offset_component(float p, float n, float near_origin, float float_sc
   LS_CONST float int_scale = 256.0f;
   int of_i = int(int_scale * n);
   float p_i = intBitsToFloat(floatBitsToInt(p) + (p < 0.0f ? -of_i : of_i));
-  return abs(p) < near_origin ? p + float_scale * n : p_i;
+  precise float p_f = p + float_scale * n;
+  return abs(p) < near_origin ? p_f : p_i;
 }
 
 // scene_scale: a power of two at least the largest absolute world coordinate (DESIGN: scale-aware).

@@ -31,20 +31,6 @@ LS_CONST uint LS_DIM_LIGHT_V = 4u;
 LS_CONST uint LS_DIM_BSDF_U = 5u;
 LS_CONST uint LS_DIM_BSDF_V = 6u;
 
-LS_FN vec3 cross_in_order(IN(vec3) a, IN(vec3) b) {
-  precise float x = a.y * b.z - b.y * a.z;
-  precise float y = a.z * b.x - b.z * a.x;
-  precise float z = a.x * b.y - b.x * a.y;
-  return vec3(x, y, z);
-}
-
-LS_FN float length_in_order(IN(vec3) v) { return sqrt(dot_in_order(v, v)); }
-
-LS_FN vec3 normalize_in_order(IN(vec3) v) {
-  precise float inv = 1.0f / sqrt(dot_in_order(v, v));
-  return v * inv;
-}
-
 LS_FN bool finite3(IN(vec3) v) {
   return !(isinf(v.x) || isnan(v.x) || isinf(v.y) || isnan(v.y) || isinf(v.z) || isnan(v.z));
 }
@@ -90,8 +76,8 @@ LS_FN float light_area_pdf(IN(vec3) e) { return shade.total_power > 0.0f ? lumin
 
 // The camera ray of pixel p for one sample: a fresh path.
 LS_FN void start_path(uint p, uint sample_index, IN(CameraFrame) cam, OUT(PathState) path) {
-  float x = float(p % cam.width) + random01(shade.seed, p, sample_index, 0u, LS_DIM_PIXEL_X);
-  float y = float(p / cam.width) + random01(shade.seed, p, sample_index, 0u, LS_DIM_PIXEL_Y);
+  precise float x = float(p % cam.width) + random01(shade.seed, p, sample_index, 0u, LS_DIM_PIXEL_X);
+  precise float y = float(p / cam.width) + random01(shade.seed, p, sample_index, 0u, LS_DIM_PIXEL_Y);
   path.ray = camera_ray(cam, x, y);
   path.shadow_ray = path.ray;
   path.throughput = vec3(1.0f, 1.0f, 1.0f);
