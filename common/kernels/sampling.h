@@ -1,18 +1,15 @@
 // Sampling for the Lambertian path tracer: cosine-weighted directions, uniform points on triangles,
 // the power heuristic for multiple importance sampling.  Shared by CPU and GPU so both draw the same
 // paths from the same random numbers.  Every sum and product is `precise`: without it a GPU compiler
-// may reassociate (lavapipe does) or fuse.  Bit-identical on lavapipe except sin and cos, which differ
-// from the C library's in the last bits; sqrt and division differ on real GPUs (TOOLCHAIN.md).
+// may reassociate (lavapipe does) or fuse.  No sin or cos (see cos_sin_turns): bit-identical on
+// lavapipe; on real GPUs sqrt and division may differ in the last bits (TOOLCHAIN.md).
 #ifndef LS_SAMPLING_H
 #define LS_SAMPLING_H
 
 #include "float_bits.h"
 
 #ifdef __cplusplus
-#include <cmath>
 namespace lsk {
-using std::cos;
-using std::sin;
 #endif
 
 LS_CONST float LS_PI = 3.14159265358979f;
@@ -29,15 +26,46 @@ LS_FN void orthonormal_basis(IN(vec3) n, OUT(vec3) b1, OUT(vec3) b2) {
   b2 = vec3(b, b2y, -n.y);
 }
 
+// cos and sin of 2 pi t for t in [0, 1): the quadrant, then Taylor polynomials (to x^15 and x^14,
+// error < 1e-11 on [0, pi/2)) in plain arithmetic, so CPU and GPU agree bit for bit where a GPU
+// rounds each operation correctly (lavapipe): GLSL's sin and cos, and the C library's, are each their
+// own approximation and differ in the last bits.
+LS_FN void cos_sin_turns(float t, OUT(float) c, OUT(float) s) {
+  precise float t4 = 4.0f * t;
+  float q = floor(t4);
+  precise float g = (t4 - q) * 1.57079632679490f;
+  precise float g2 = g * g;
+  precise float sg = g * (1.0f + g2 * (-0.166666666667f + g2 * (8.33333333333e-3f + g2 * (-1.98412698413e-4f +
+                     g2 * (2.75573192240e-6f + g2 * (-2.50521083854e-8f + g2 * (1.60590438368e-10f +
+                     g2 * -7.64716373182e-13f)))))));
+  precise float cg = 1.0f + g2 * (-0.5f + g2 * (4.16666666667e-2f + g2 * (-1.38888888889e-3f + g2 * (2.48015873016e-5f +
+                     g2 * (-2.75573192240e-7f + g2 * (2.08767569879e-9f + g2 * -1.14707455977e-11f))))));
+  if (q < 1.0f) {
+    c = cg;
+    s = sg;
+  } else if (q < 2.0f) {
+    c = -sg;
+    s = cg;
+  } else if (q < 3.0f) {
+    c = -cg;
+    s = -sg;
+  } else {
+    c = sg;
+    s = -cg;
+  }
+}
+
 // A direction about unit n with density cos(theta) / pi.
 LS_FN vec3 sample_cosine_hemisphere(IN(vec3) n, float u1, float u2) {
   float r = sqrt(u1);
-  precise float phi = 2.0f * LS_PI * u2;
+  float cos_phi;
+  float sin_phi;
+  cos_sin_turns(u2, cos_phi, sin_phi);
   vec3 b1;
   vec3 b2;
   orthonormal_basis(n, b1, b2);
   precise float one_minus = 1.0f - u1;
-  precise vec3 d = b1 * (r * cos(phi)) + b2 * (r * sin(phi)) + n * sqrt(max(0.0f, one_minus));
+  precise vec3 d = b1 * (r * cos_phi) + b2 * (r * sin_phi) + n * sqrt(max(0.0f, one_minus));
   return normalize_in_order(d);
 }
 
