@@ -38,6 +38,17 @@ LightSet::LightSet(const Scene& scene, const SurfaceLookup& surfaces) {
   total_power = float(sum);
 }
 
+void average_passes(RenderResult& result, int spp) {
+  const size_t pixels = size_t(result.width) * result.height;
+  const float inv_spp = 1.0f / float(std::max(1, spp));
+  result.total.assign(pixels, glm::vec3(0.0f));
+  for (auto& img : result.bounce_images)
+    for (size_t p = 0; p < pixels; ++p) {
+      img[p] *= inv_spp;
+      result.total[p] += img[p];
+    }
+}
+
 lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& lights, const RenderOptions& options) {
   lsk::ShadeContext c = surfaces.context();
   c.lights = lights.lights.data();
@@ -164,13 +175,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
     if (progress) progress(s + 1, options.spp);
   }
 
-  const float inv_spp = 1.0f / float(std::max(1, options.spp));
-  result.total.assign(pixels, glm::vec3(0.0f));
-  for (auto& img : result.bounce_images)
-    for (uint32_t p = 0; p < pixels; ++p) {
-      img[p] *= inv_spp;
-      result.total[p] += img[p];
-    }
+  average_passes(result, options.spp);
   for (uint32_t d : dropped) result.dropped_samples += d;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -76,6 +76,9 @@ struct LightSet {
 // The shading kernel's context for a render: the surfaces' arrays, the lights and the options.
 lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& lights, const RenderOptions& options);
 
+// Turns the bounce images' sums over spp passes into averages and fills the total image.
+void average_passes(RenderResult& result, int spp);
+
 // structures: built structures keyed by canonical name; every schedule entry must be present.
 // tracer: where the batches are traced (empty: trace_rays on all CPU threads).
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,

@@ -1,7 +1,8 @@
-// The path tracer with every bounce's rays traced on the GPU: the CPU renderer's wavefront
-// (cpu/path_tracer.h) with its batches handed to GpuTracer, so schedules, bounce semantics, random
-// numbers and outputs are the CPU's by construction.  Shading (NEE + MIS) still runs on the CPU: the
-// single-source shading kernel that would move it to the GPU is not written yet (gpu/README.md).
+// The path tracer's wavefront on the GPU: camera rays, tracing, shading (NEE + MIS) and the shadow
+// rays' light run in shaders (trace.comp, shade.comp) with the CPU renderer's kernels
+// (common/kernels/shade_path.h); the host loops over passes and bounces and reads back the ray counts,
+// the images and the trace dispatches' timestamp times.  Same schedules, bounce semantics, random
+// numbers and outputs as ls::render (cpu/path_tracer.h); on lavapipe the same images bit for bit.
 #pragma once
 
 #include "path_tracer.h"

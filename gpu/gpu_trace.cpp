@@ -22,23 +22,31 @@ void GpuTracer::set_rays(const std::vector<lsk::Ray>& rays) {
 }
 
 std::vector<lsk::Hit> GpuTracer::trace(const GpuAccel& accel, bool any_hit, lsk::LsCounters* counters, GpuTraceTiming* timing) {
+  trace_buffers(accel, rays_, hits_, count_, any_hit, counters, timing);
+  std::vector<lsk::Hit> hits(count_);
+  if (count_) hits_.download(hits.data(), hits.size() * sizeof(lsk::Hit));
+  return hits;
+}
+
+void GpuTracer::trace_buffers(const GpuAccel& accel, const Buffer& rays, const Buffer& hits, uint32_t count, bool any_hit,
+                              lsk::LsCounters* counters, GpuTraceTiming* timing) {
   std::vector<const Buffer*> bindings = accel.bindings();
-  bindings.push_back(&rays_);
-  bindings.push_back(&hits_);
+  bindings.push_back(&rays);
+  bindings.push_back(&hits);
   bindings.push_back(&counters_);
   pipeline_.bind(bindings);
   const lsk::LsCounters zero{};
   counters_.upload(&zero, sizeof(zero));
   ShaderParams params = accel.params();
   params.any_hit = any_hit ? 1u : 0u;
-  params.count = count_;
+  params.count = count;
   const auto start = std::chrono::steady_clock::now();
   context_.submit_and_wait([&](VkCommandBuffer cmd) {
     timer_.begin(cmd);
     // Dispatches of at most kMaxGroups groups; they write disjoint hits, so no barrier between them.
-    for (uint32_t first = 0; first < count_; first += kGroup * kMaxGroups) {
+    for (uint32_t first = 0; first < count; first += kGroup * kMaxGroups) {
       params.first = first;
-      const uint32_t n = std::min(count_ - first, kGroup * kMaxGroups);
+      const uint32_t n = std::min(count - first, kGroup * kMaxGroups);
       pipeline_.record(cmd, &params, (n + kGroup - 1) / kGroup);
     }
     timer_.end(cmd);
@@ -47,14 +55,11 @@ std::vector<lsk::Hit> GpuTracer::trace(const GpuAccel& accel, bool any_hit, lsk:
     timing->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     timing->kernel_seconds = timer_.seconds();
   }
-  std::vector<lsk::Hit> hits(count_);
-  if (count_) hits_.download(hits.data(), hits.size() * sizeof(lsk::Hit));
   if (counters) {
     lsk::LsCounters got{};
     counters_.download(&got, sizeof(got));
     add_counters(*counters, got);
   }
-  return hits;
 }
 
 }  // namespace ls::gpu

@@ -23,6 +23,9 @@ class GpuTracer {
   // Traces the rays set last; hits and counters (added to *counters) as on the CPU.
   std::vector<lsk::Hit> trace(const GpuAccel& accel, bool any_hit, lsk::LsCounters* counters = nullptr,
                               GpuTraceTiming* timing = nullptr);
+  // Traces the first `count` rays of a device buffer into `hits` (both stay on the device).
+  void trace_buffers(const GpuAccel& accel, const Buffer& rays, const Buffer& hits, uint32_t count, bool any_hit,
+                     lsk::LsCounters* counters = nullptr, GpuTraceTiming* timing = nullptr);
 
  private:
   const VulkanContext& context_;

@@ -7,4 +7,5 @@
 namespace ls::gpu {
 const std::vector<uint32_t>& spirv_trace();          // shaders/trace.comp
 const std::vector<uint32_t>& spirv_ls_candidates();  // shaders/ls_candidates.comp
+const std::vector<uint32_t>& spirv_shade();          // shaders/shade.comp
 }  // namespace ls::gpu
