@@ -388,29 +388,66 @@ class GltfReader {
 
 }  // namespace
 
-Scene load_gltf(const std::string& path) {
+namespace {
+
+// Loads through `load` (which fills model, err and warn), then reads and validates the model.
+template <typename Load>
+Scene load_gltf_with(const std::string& name, Load&& load) {
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(ignore_image, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   bool ok = false;
   try {
-    ok = lower_ext(path) == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                                   : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    ok = load(loader, model, err, warn);
   } catch (const std::bad_alloc&) {
     throw;
   } catch (const std::exception& e) {  // tinygltf 2.7 indexes with .at() on some malformed files
-    throw InputError(path + ": malformed glTF (" + e.what() + ")");
+    throw InputError(name + ": malformed glTF (" + e.what() + ")");
   }
   // Warnings alone (an unreadable texture, say) do not matter: only colour factors are used.
-  if (!ok) throw InputError(path + ": " + first_line(err.empty() ? warn : err));
+  if (!ok) throw InputError(name + ": " + first_line(err.empty() ? warn : err));
 
-  GltfReader reader(model, path);
+  GltfReader reader(model, name);
   Scene scene = reader.read();
-  scene.name = path;
+  scene.name = name;
   validate_scene(scene);
   if (!reader.has_camera()) scene.camera = framing_camera(scene);
   return scene;
+}
+
+// File callbacks for bytes in memory: no file may be opened (a URI would name one relative to a
+// folder the bytes do not have).
+bool no_file_exists(const std::string&, void*) { return false; }
+std::string no_expand(const std::string& path, void*) { return path; }
+bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+  if (err) *err += "external file '" + path + "' cannot be read from bytes in memory\n";
+  return false;
+}
+bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+  const bool binary = lower_ext(path) == ".glb";
+  return load_gltf_with(path, [&](tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn) {
+    return binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                  : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  });
+}
+
+Scene load_gltf_bytes(const std::string& bytes, const std::string& name, bool binary) {
+  return load_gltf_with(name, [&](tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn) {
+    tinygltf::FsCallbacks fs{&no_file_exists, &no_expand, &no_read, &no_write, nullptr};
+    loader.SetFsCallbacks(fs);
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    if (bytes.size() > UINT32_MAX) {
+      err = "larger than 4 GiB";
+      return false;
+    }
+    return binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), "")
+                  : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), "");
+  });
 }
 
 }  // namespace ls
