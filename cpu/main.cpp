@@ -2,7 +2,9 @@
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
 #include "accel.h"
 #include "bench.h"
+#include "interrupt.h"
 #include "load_scene.h"
+#include "memory_budget.h"
 #include "path_tracer.h"
 #include "ray_files.h"
 #include "ray_generators.h"
@@ -104,6 +106,7 @@ struct LsFlags {
   uint32_t min_triangles = LsOptions{}.min_triangles;
   std::string candidates = "compact";
   double max_memory_mb = 0.0;
+  bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
 
   void add_to(CLI::App* app) {
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
@@ -114,7 +117,7 @@ struct LsFlags {
         ->capture_default_str();
     app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
         ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
-    app->add_option("--max-memory", max_memory_mb, "refuse a Line Space estimated above this many MB (0: half of RAM)")
+    app->add_option("--max-memory", max_memory_mb, "refuse a structure or render estimated above this many MB (0: half of RAM)")
         ->check(CLI::Range(0.0, 1e9));
   }
   AccelOptions options() const {
@@ -124,6 +127,10 @@ struct LsFlags {
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
     o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    if (progress)
+      o.ls.progress = [](size_t done, size_t total) {
+        std::fprintf(stderr, "\rline space: %zu/%zu LS nodes%s", done, total, done == total ? "\n" : "");
+      };
     return o;
   }
 };
@@ -140,6 +147,7 @@ void print_counters(const lsk::LsCounters& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_interrupt_handlers();  // Ctrl-C: stop cleanly, exit 130, no output file half-written
   CLI::App app{"linespace-cpu: exact and Line Space ray tracing, CPU reference"};
   app.require_subcommand(1);
   std::string scene_spec = "builtin:cornell";
@@ -208,6 +216,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  ls_flags.progress = isatty(2) && !quiet;
   try {
     const Scene scene = load_scene(scene_spec);
     if (*build) {
@@ -238,6 +247,7 @@ int main(int argc, char** argv) {
       options.spp = spp;
       options.bounces = bounces;
       options.seed = seed;
+      check_render_budget(options.width, options.height, bounces, ls_flags.options().ls.max_memory);
       std::map<std::string, Accel> built = build_schedule_structures(scene, options.schedule, ls_flags.options());
       const bool show = !quiet && isatty(2);
       Progress progress = [&](int done, int total) {
@@ -269,6 +279,9 @@ int main(int argc, char** argv) {
       if (bench_rays.empty()) throw InputError("bench: the ray file holds no rays");
       print_bench(run_bench(scene, bench_rays, specs, repeats, ls_flags.options()), json);
     }
+  } catch (const Interrupted& e) {
+    std::cerr << "\nlinespace-cpu: " << e.what() << ", stopped (no partially written output file is left)\n";
+    return 128 + interrupt_signal();
   } catch (const InputError& e) {
     std::cerr << "linespace-cpu: " << e.what() << "\n";
     return 2;

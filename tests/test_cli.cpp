@@ -4,10 +4,14 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -130,4 +134,81 @@ TEST_CASE("render writes every image and a report", "[cli]") {
   CHECK(j["per_bounce"][0]["extension_rays"].get<int>() == 16 * 12);
   CHECK(j["indirect"]["rays"].get<long>() > 0);
   CHECK(j.contains("primary"));
+  CHECK(j["dropped_samples"].get<long>() == 0);  // non-finite contributions left out, always reported
+}
+
+TEST_CASE("over-budget structures and renders exit 2 in under 2 s naming estimate, budget and flag", "[cli]") {
+  const std::array<std::pair<std::string, std::string>, 4> cases = {{
+      {"build --scene builtin:instances --structure f-ls:8:64 --max-memory 4000", "lower N or D"},
+      {"build --scene builtin:instances --structure f-ls:30:10 --max-memory 4000", "lower N or D"},
+      {"build --scene builtin:instances --structure bvh --max-memory 16", "smaller scene"},
+      {"render --scene builtin:cornell --size 16384x16384 --bounces 64 --max-memory 4000 --out " + temp("big").string(),
+       "--size"},
+  }};
+  for (const auto& [args, advice] : cases) {
+    const auto start = std::chrono::steady_clock::now();
+    const Run r = run(args);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    INFO(args << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find("MiB") != std::string::npos);
+    CHECK(r.err.find("budget of 3815 MiB") != std::string::npos);  // 4000 MB
+    CHECK(r.err.find(advice) != std::string::npos);
+    CHECK(r.err.find("--max-memory") != std::string::npos);
+    CHECK(seconds < 2.0);
+  }
+  CHECK(!fs::exists(temp("big")));
+}
+
+namespace {
+
+// Starts linespace-cpu with `args` (stderr to err_path), sends `signal` after `delay` seconds and
+// returns its exit status (-1: killed by a signal or still running after 60 s).
+int run_and_signal(const std::vector<std::string>& args, const std::string& err_path, int signal, double delay) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(LINESPACE_CPU)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    if (!std::freopen(err_path.c_str(), "w", stderr) || !std::freopen("/dev/null", "w", stdout)) _exit(99);
+    execv(LINESPACE_CPU, argv.data());
+    _exit(98);
+  }
+  usleep(useconds_t(delay * 1e6));
+  kill(pid, signal);
+  int status = 0;
+  for (int waited = 0; waited < 600; ++waited) {  // up to 60 s
+    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    usleep(100000);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  return -1;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+}  // namespace
+
+TEST_CASE("SIGINT during render and SIGTERM during a build exit 128+signal leaving no output file", "[cli]") {
+  fs::create_directories(temp(""));
+  const fs::path out = temp("interrupted_render"), err = temp("interrupt.err");
+  fs::remove_all(out);
+  // Far longer than the delay: the signal arrives mid-render.
+  int status = run_and_signal({"render", "--scene", "builtin:cornell", "--size", "256x256", "--spp", "65536", "--out",
+                               out.string()},
+                              err.string(), SIGINT, 1.5);
+  INFO("stderr: " << slurp(err));
+  CHECK(status == 130);
+  CHECK(slurp(err).find("interrupted by SIGINT") != std::string::npos);
+  CHECK((!fs::exists(out) || fs::is_empty(out)));
+
+  status = run_and_signal({"build", "--scene", "builtin:instances", "--structure", "f-ls:6:14"}, err.string(), SIGTERM, 1.5);
+  INFO("stderr: " << slurp(err));
+  CHECK(status == 143);
+  CHECK(slurp(err).find("interrupted by SIGTERM") != std::string::npos);
 }
