@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace ls {
 namespace {
@@ -196,8 +197,10 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
         PathState& path = paths[p];
         const lsk::Hit& hit = batch_hits[i];
         has_shadow[p] = 0;
+        // The sum is what is checked: two huge finite contributions can add up to infinity.
         auto add = [&](const glm::vec3& c) {
-          if (finite(c)) image[p] += c;
+          const glm::vec3 sum = image[p] + c;
+          if (finite(sum)) image[p] = sum;
           else ++dropped[p];
         };
         if (hit.triangle == lsk::LS_INVALID) {
@@ -274,7 +277,8 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
         const ShadowQuery& sq = shadows[active[i]];
-        if (finite(sq.contribution)) image[sq.pixel] += sq.contribution;
+        const glm::vec3 sum = image[sq.pixel] + sq.contribution;
+        if (finite(sum)) image[sq.pixel] = sum;
         else ++dropped[sq.pixel];
       });
     }
@@ -284,11 +288,17 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   const float inv_spp = 1.0f / float(std::max(1, options.spp));
   result.total.assign(pixels, glm::vec3(0.0f));
   for (auto& img : result.bounce_images)
-    for (uint32_t p = 0; p < pixels; ++p) {
-      img[p] *= inv_spp;
-      result.total[p] += img[p];
-    }
+    for (uint32_t p = 0; p < pixels; ++p) img[p] *= inv_spp;
   for (uint32_t d : dropped) result.dropped_samples += d;
+  // The total adds finite bounce images; one whose sum passes the float range keeps the largest
+  // float instead (and is counted with the dropped samples): no image ever holds Inf or NaN.
+  for (uint32_t p = 0; p < pixels; ++p) {
+    glm::dvec3 sum(0.0);
+    for (const auto& img : result.bounce_images) sum += glm::dvec3(img[p]);
+    const glm::dvec3 clamped = glm::min(sum, glm::dvec3(double(std::numeric_limits<float>::max())));
+    result.total[p] = glm::vec3(clamped);
+    if (clamped != sum) ++result.dropped_samples;
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -195,7 +196,8 @@ class GltfReader {
     for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
       const tinygltf::Primitive& prim = gm.primitives[pi];
       const std::string where = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi);
-      const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+      // tinygltf writes TRIANGLES for an absent mode (-1 only in a default-constructed primitive).
+      const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
       if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE || mode == TINYGLTF_MODE_LINE_LOOP ||
           mode == TINYGLTF_MODE_LINE_STRIP)
         fail(where + ": non-triangle primitive (points or lines)");
@@ -370,7 +372,10 @@ class GltfReader {
       if (!finite(position) || !forward || !up)
         fail("camera node " + std::to_string(*camera_node) + " has a degenerate transform");
       scene.camera.position = position;
-      scene.camera.target = position + *forward;
+      // One unit ahead vanishes into the rounding of a position 1e30 away: look as far ahead as the
+      // position is from the origin.
+      const float reach = std::max({1.0f, std::fabs(position.x), std::fabs(position.y), std::fabs(position.z)});
+      scene.camera.target = position + *forward * reach;
       scene.camera.up = *up;
       scene.camera.yfov = float(yfov);
       has_camera_ = true;

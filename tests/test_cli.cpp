@@ -1,5 +1,7 @@
 // linespace-cpu end to end: the file formats, the JSON keys of DESIGN §9, and exit status 2 with a
 // one-line reason on bad input.
+#include "gltf_writer.h"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -211,4 +213,40 @@ TEST_CASE("SIGINT during render and SIGTERM during a build exit 128+signal leavi
   INFO("stderr: " << slurp(err));
   CHECK(status == 143);
   CHECK(slurp(err).find("interrupted by SIGTERM") != std::string::npos);
+}
+
+TEST_CASE("hostile scenes through linespace-cpu: exit 2 with one line, or a finite render", "[cli]") {
+  using namespace ls_test;
+  fs::create_directories(temp(""));
+  const auto triangles = [](const std::string& material, const std::string& nodes) {
+    Gltf g;
+    const int pos = g.vec3({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, -1, 0}, {1, 1, 0}, {-1, 1, 0}});
+    return g.json(R"("materials":[)" + material + R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":)" +
+                  std::to_string(pos) + R"(},"material":0}]}],)" + nodes);
+  };
+  const std::string one_node = R"("nodes":[{"mesh":0}])";
+  {
+    Gltf g;
+    g.vec3(kTriangle);  // view 0, accessor 0; accessor 1 reads the same bytes as unsigned shorts
+    g.accessor(R"({"bufferView":0,"componentType":5123,"count":3,"type":"VEC3"})");
+    write_text(temp("shorts.glb"), g.glb(R"("meshes":[{"primitives":[{"attributes":{"POSITION":1}}]}],"nodes":[{"mesh":0}])"));
+  }
+  write_text(temp("strength.gltf"), triangles(R"({"emissiveFactor":[10,10,10],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":1e38}}})", one_node));
+  write_text(temp("cycle.gltf"), triangles("{}", R"("nodes":[{"mesh":0,"children":[1]},{"children":[0]}],"scenes":[{"nodes":[0]}])"));
+  write_text(temp("mirror_singular.gltf"), triangles("{}", R"("nodes":[{"mesh":0,"scale":[-1,0,1]}])"));
+  for (const char* name : {"shorts.glb", "strength.gltf", "cycle.gltf", "mirror_singular.gltf"}) {
+    const Run r = run("render --size 8x8 --spp 1 --scene " + temp(name).string() + " --out " + temp("hostile_out").string());
+    INFO(name << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find(temp(name).string()) != std::string::npos);
+  }
+  CHECK(!fs::exists(temp("hostile_out")));
+  // A mirroring transform and a light of zero power: valid, rendered (black), no sample dropped.
+  write_text(temp("mirror_dark.gltf"), triangles(R"({"emissiveFactor":[0,0,0]})", R"("nodes":[{"mesh":0,"scale":[-1,1,1]}])"));
+  const Run r = run("render --size 8x8 --spp 1 --scene " + temp("mirror_dark.gltf").string() + " --out " + temp("dark").string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  std::ifstream f(temp("dark") / "report.json");
+  CHECK(nlohmann::json::parse(f)["dropped_samples"].get<long>() == 0);
 }
