@@ -13,9 +13,11 @@ namespace {
 std::string mib(double bytes) { return std::to_string(uint64_t(std::ceil(bytes / double(1 << 20)))) + " MiB"; }
 
 // Per triangle while building: the triangle (48 B), its id and instance (8 B), its box and the
-// builder's order and centroid arrays (~64 B), the flat build's world copy (48 B) and the octahedral
-// normals of a Line Space (16 B); per node 32 B, at most 2 nodes per triangle.
-constexpr double kBytesPerTriangle = 48 + 8 + 64 + 48 + 16 + 2 * sizeof(lsk::BvhNode);
+// builder's order and centroid arrays (~64 B), the flat build's world copy (48 B); per node 32 B, at
+// most 2 nodes per triangle.
+constexpr double kBytesPerTriangle = 48 + 8 + 64 + 48 + 2 * sizeof(lsk::BvhNode);
+// A Line Space adds per triangle its octahedral vertex normals (16 B) and per BVH node its LS index.
+constexpr double kLsBytesPerTriangle = sizeof(glm::uvec4) + 2 * sizeof(uint32_t);
 
 // At most this many LS nodes in a BVH over `triangles` at depth `depth` (double: 2^60 is fine).
 double ls_nodes_at_most(size_t triangles, int depth, uint32_t min_triangles) {
@@ -37,14 +39,16 @@ StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSp
   } else {
     per_bvh.push_back(triangle_count(scene));
   }
-  double bvh = 0.0, nodes = 0.0;
+  double bvh = 0.0, nodes = 0.0, triangles = 0.0;
   for (size_t t : per_bvh) {
     bvh += double(t) * kBytesPerTriangle;
+    triangles += double(t);
     if (spec.line_space()) nodes += ls_nodes_at_most(t, spec.depth, ls.min_triangles);
   }
   if (spec.two_level()) bvh += double(scene.instances.size()) * (sizeof(lsk::InstanceRecord) + 2 * sizeof(lsk::BvhNode) + 64);
   const double shaft_bytes = 4.0 * 30.0 * std::pow(double(spec.subdivision), 4.0);
-  const double ls_bytes = spec.line_space() ? nodes * (shaft_bytes + sizeof(lsk::LsNode)) : 0.0;
+  const double ls_bytes =
+      spec.line_space() ? nodes * (shaft_bytes + sizeof(lsk::LsNode)) + triangles * kLsBytesPerTriangle : 0.0;
   // Saturate instead of overflowing size_t (2^60 nodes of 2 GB each are representable in double).
   const double cap = double(SIZE_MAX / 4);
   StructureEstimate e;

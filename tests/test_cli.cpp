@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 #include <sys/wait.h>
@@ -140,14 +141,15 @@ TEST_CASE("render writes every image and a report", "[cli]") {
 }
 
 TEST_CASE("over-budget structures and renders exit 2 in under 2 s naming estimate, budget and flag", "[cli]") {
-  const std::array<std::pair<std::string, std::string>, 4> cases = {{
-      {"build --scene builtin:instances --structure f-ls:8:64 --max-memory 4000", "lower N or D"},
-      {"build --scene builtin:instances --structure f-ls:30:10 --max-memory 4000", "lower N or D"},
-      {"build --scene builtin:instances --structure bvh --max-memory 16", "smaller scene"},
+  // 4000 MB = 3815 MiB (rounded up), 16 MB = 16 MiB.
+  const std::array<std::tuple<std::string, std::string, std::string>, 4> cases = {{
+      {"build --scene builtin:instances --structure f-ls:8:64 --max-memory 4000", "budget of 3815 MiB", "lower N or D"},
+      {"build --scene builtin:instances --structure f-ls:30:10 --max-memory 4000", "budget of 3815 MiB", "lower N or D"},
+      {"build --scene builtin:instances --structure bvh --max-memory 16", "budget of 16 MiB", "smaller scene"},
       {"render --scene builtin:cornell --size 16384x16384 --bounces 64 --max-memory 4000 --out " + temp("big").string(),
-       "--size"},
+       "budget of 3815 MiB", "--size"},
   }};
-  for (const auto& [args, advice] : cases) {
+  for (const auto& [args, budget, advice] : cases) {
     const auto start = std::chrono::steady_clock::now();
     const Run r = run(args);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -155,7 +157,7 @@ TEST_CASE("over-budget structures and renders exit 2 in under 2 s naming estimat
     CHECK(r.status == 2);
     CHECK(line_count(r.err) == 1);
     CHECK(r.err.find("MiB") != std::string::npos);
-    CHECK(r.err.find("budget of 3815 MiB") != std::string::npos);  // 4000 MB
+    CHECK(r.err.find(budget) != std::string::npos);
     CHECK(r.err.find(advice) != std::string::npos);
     CHECK(r.err.find("--max-memory") != std::string::npos);
     CHECK(seconds < 2.0);
