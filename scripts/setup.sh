@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake ninja-build pkg-config
   libtbb-dev libxsimd-dev libglm-dev libopenimageio-dev openimageio-tools
   glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
-  mesa-vulkan-drivers libvulkan-dev vulkan-tools)
+  mesa-vulkan-drivers libvulkan-dev vulkan-tools
+  clang-14 libclang-rt-14-dev)  # clang-14 + its runtimes: the libFuzzer harnesses (scripts/run-sanitizers.sh)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -93,9 +93,12 @@ TEST_CASE("hostile glTF: wrong component types are refused", "[hostile]") {
   refused(with_accessor(kPositions + R"(,{"bufferView":0,"componentType":5121,"count":3,"type":"VEC3"})",
                         R"(,"indices":1)"),
           "wrong type", "indices of type VEC3");
-  refused(with_accessor(kPositions + R"(,{"bufferView":0,"componentType":5126,"count":3,"type":"VEC2"})",
-                        R"(,"attributes":{"POSITION":0,"NORMAL":1})"),
-          "", "NORMAL of type VEC2 (or a duplicate attributes key)");
+  std::string normal_vec2 = with_accessor(kPositions + R"(,{"bufferView":0,"componentType":5126,"count":3,"type":"VEC2"})");
+  normal_vec2.replace(normal_vec2.find(R"({"POSITION":0})"), 14, R"({"POSITION":0,"NORMAL":1})");
+  refused(normal_vec2, "NORMAL accessor 1 has the wrong type", "NORMAL of type VEC2");
+  refused(with_accessor(R"({"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","sparse":{"count":1,)"
+                        R"("indices":{"bufferView":0,"componentType":5125},"values":{"bufferView":0}}})"),
+          "sparse", "sparse accessor");
 }
 
 TEST_CASE("hostile glTF: every non-triangle and unknown primitive mode is refused", "[hostile]") {
