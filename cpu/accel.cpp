@@ -1,5 +1,7 @@
 #include "accel.h"
 
+#include "memory_budget.h"
+
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -173,6 +175,8 @@ lsk::TraceContext Accel::context() const {
 }
 
 Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) {
+  // Refuse from the scene and parameters alone, before any large allocation (memory_budget.h).
+  check_structure_budget(scene, spec, options.ls);
   const auto start = std::chrono::steady_clock::now();
   Accel accel;
   accel.spec = spec;

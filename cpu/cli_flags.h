@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <string>
 
 namespace ls {
@@ -42,6 +43,7 @@ struct LsFlags {
   uint32_t min_triangles = LsOptions{}.min_triangles;
   std::string candidates = "compact";
   double max_memory_mb = 0.0;
+  bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
 
   void add_to(CLI::App* app) {
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
@@ -52,7 +54,7 @@ struct LsFlags {
         ->capture_default_str();
     app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
         ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
-    app->add_option("--max-memory", max_memory_mb, "refuse a Line Space estimated above this many MB (0: half of RAM)")
+    app->add_option("--max-memory", max_memory_mb, "refuse a structure or render estimated above this many MB (0: half of RAM)")
         ->check(CLI::Range(0.0, 1e9));
   }
   AccelOptions options() const {
@@ -62,6 +64,10 @@ struct LsFlags {
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
     o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    if (progress)
+      o.ls.progress = [](size_t done, size_t total) {
+        std::fprintf(stderr, "\rline space: %zu/%zu LS nodes%s", done, total, done == total ? "\n" : "");
+      };
     return o;
   }
 };

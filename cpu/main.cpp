@@ -4,7 +4,9 @@
 #include "cli_flags.h"
 #include "cli_report.h"
 #include "bench.h"
+#include "interrupt.h"
 #include "load_scene.h"
+#include "memory_budget.h"
 #include "path_tracer.h"
 #include "ray_files.h"
 #include "ray_generators.h"
@@ -46,6 +48,7 @@ void print_bench(const BenchResult& r, bool json) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_interrupt_handlers();  // Ctrl-C: stop cleanly, exit 130, no output file half-written
   CLI::App app{"linespace-cpu: exact and Line Space ray tracing, CPU reference"};
   app.require_subcommand(1);
   std::string scene_spec = "builtin:cornell";
@@ -114,6 +117,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  ls_flags.progress = isatty(2) && !quiet;
   try {
     const Scene scene = load_scene(scene_spec);
     if (*build) {
@@ -144,6 +148,7 @@ int main(int argc, char** argv) {
       options.spp = spp;
       options.bounces = bounces;
       options.seed = seed;
+      check_render_budget(options.width, options.height, bounces, ls_flags.options().ls.max_memory);
       std::map<std::string, Accel> built = build_schedule_structures(scene, options.schedule, ls_flags.options());
       const bool show = !quiet && isatty(2);
       Progress progress = [&](int done, int total) {
@@ -175,6 +180,9 @@ int main(int argc, char** argv) {
       if (bench_rays.empty()) throw InputError("bench: the ray file holds no rays");
       print_bench(run_bench(scene, bench_rays, specs, repeats, ls_flags.options()), json);
     }
+  } catch (const Interrupted& e) {
+    std::cerr << "\nlinespace-cpu: " << e.what() << ", stopped (no partially written output file is left)\n";
+    return 128 + interrupt_signal();
   } catch (const InputError& e) {
     std::cerr << "linespace-cpu: " << e.what() << "\n";
     return 2;

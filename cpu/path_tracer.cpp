@@ -4,6 +4,8 @@
 #include "kernels/offset_ray.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
+#include "kernels/scaled_geometry.h"
+#include "interrupt.h"
 #include "surface.h"
 
 #include <tbb/parallel_for.h>
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace ls {
 namespace {
@@ -20,17 +23,20 @@ enum Dim : uint32_t { kPixelX = 0, kPixelY = 1, kLightPick = 2, kLightU = 3, kLi
 
 struct Light {
   glm::vec3 a, b, c;
+  glm::vec3 normal;  // unit
   glm::vec3 emission;
-  float area;
+  float area;        // in scene units (kernels/scaled_geometry.h), like every pdf below
 };
 
-// Emissive world triangles with a CDF by power (area x luminance of emission).
+// Emissive world triangles with a CDF by power (area x luminance of emission).  Areas, distances
+// and densities are in scene units (lengths x 2^unit_k), so they stay finite at 1e20 and 1e-20.
 struct LightSet {
   std::vector<Light> lights;
   std::vector<float> cdf;  // inclusive, last == 1
   float total_power = 0.0f;
+  int unit_k = 0;
 
-  LightSet(const Scene& scene, const SurfaceLookup& surfaces) {
+  LightSet(const Scene& scene, const SurfaceLookup& surfaces) : unit_k(lsk::unit_exponent(surfaces.scene_scale())) {
     std::vector<double> power;
     for (uint32_t i = 0; i < scene.instances.size(); ++i) {
       const Mesh& mesh = scene.meshes[scene.instances[i].mesh];
@@ -40,7 +46,7 @@ struct LightSet {
         Light l;
         surfaces.world_triangle(i, t, l.a, l.b, l.c);
         l.emission = e;
-        l.area = 0.5f * glm::length(glm::cross(l.b - l.a, l.c - l.a));
+        l.area = lsk::triangle_area_scaled(l.a, l.b, l.c, unit_k, l.normal);
         if (!(l.area > 0.0f) || !std::isfinite(l.area)) continue;
         lights.push_back(l);
         power.push_back(double(l.area) * lsk::luminance(e));
@@ -149,6 +155,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   std::vector<uint32_t> dropped(pixels, 0);
 
   for (int s = 0; s < options.spp; ++s) {
+    throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
     const uint32_t sample = uint32_t(s);
     tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) {
       const float x = float(p % options.width) + lsk::random01(options.seed, p, sample, 0, kPixelX);
@@ -160,6 +167,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
     });
 
     for (int k = 0; k <= bounces; ++k) {
+      throw_if_interrupted();
       const uint32_t bounce = uint32_t(k);
       const Accel& structure = *accel[size_t(k)];
       BounceStats& stats = result.bounces[size_t(k)];
@@ -190,8 +198,10 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
         PathState& path = paths[p];
         const lsk::Hit& hit = batch_hits[i];
         has_shadow[p] = 0;
+        // The sum is what is checked: two huge finite contributions can add up to infinity.
         auto add = [&](const glm::vec3& c) {
-          if (finite(c)) image[p] += c;
+          const glm::vec3 sum = image[p] + c;
+          if (finite(sum)) image[p] = sum;
           else ++dropped[p];
         };
         if (hit.triangle == lsk::LS_INVALID) {
@@ -204,7 +214,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
         if (lsk::luminance(mat.emission) > 0.0f) {
           float weight = 1.0f;
           if (k > 0) {
-            const float dist = hit.t * glm::length(path.ray.dir);
+            const float dist = lsk::to_scene_units(hit.t * glm::length(path.ray.dir), lights.unit_k);
             const float cos_l = std::fabs(glm::dot(sp.geometric_normal, glm::normalize(path.ray.dir)));
             const float light_pdf = cos_l > 0.0f ? lights.area_pdf(mat.emission) * dist * dist / cos_l : 0.0f;
             weight = lsk::power_heuristic(path.bsdf_pdf, light_pdf);
@@ -217,13 +227,13 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
           const Light& l = lights.lights[lights.pick(lsk::random01(options.seed, p, sample, bounce, kLightPick))];
           const glm::vec3 q = lsk::sample_triangle(l.a, l.b, l.c, lsk::random01(options.seed, p, sample, bounce, kLightU),
                                                    lsk::random01(options.seed, p, sample, bounce, kLightV));
-          glm::vec3 nl = glm::cross(l.b - l.a, l.c - l.a);
-          nl = glm::normalize(nl);
+          glm::vec3 nl = l.normal;
           if (glm::dot(nl, origin - q) < 0.0f) nl = -nl;
           const glm::vec3 target = lsk::offset_ray_origin(q, nl, scale);
           const glm::vec3 d = target - origin;
-          const float dist2 = glm::dot(d, d);
-          const glm::vec3 wi = d / std::sqrt(dist2);
+          const glm::vec3 d_units = lsk::to_scene_units(d, lights.unit_k);
+          const float dist2 = glm::dot(d_units, d_units);
+          const glm::vec3 wi = d_units / std::sqrt(dist2);
           const float cos_s = glm::dot(n, wi);
           const float cos_l = glm::dot(nl, -wi);
           if (cos_s > 0.0f && cos_l > 0.0f && dist2 > 0.0f) {
@@ -268,7 +278,8 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
         const ShadowQuery& sq = shadows[active[i]];
-        if (finite(sq.contribution)) image[sq.pixel] += sq.contribution;
+        const glm::vec3 sum = image[sq.pixel] + sq.contribution;
+        if (finite(sum)) image[sq.pixel] = sum;
         else ++dropped[sq.pixel];
       });
     }
@@ -278,11 +289,17 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   const float inv_spp = 1.0f / float(std::max(1, options.spp));
   result.total.assign(pixels, glm::vec3(0.0f));
   for (auto& img : result.bounce_images)
-    for (uint32_t p = 0; p < pixels; ++p) {
-      img[p] *= inv_spp;
-      result.total[p] += img[p];
-    }
+    for (uint32_t p = 0; p < pixels; ++p) img[p] *= inv_spp;
   for (uint32_t d : dropped) result.dropped_samples += d;
+  // The total adds finite bounce images; one whose sum passes the float range keeps the largest
+  // float instead (and is counted with the dropped samples): no image ever holds Inf or NaN.
+  for (uint32_t p = 0; p < pixels; ++p) {
+    glm::dvec3 sum(0.0);
+    for (const auto& img : result.bounce_images) sum += glm::dvec3(img[p]);
+    const glm::dvec3 clamped = glm::min(sum, glm::dvec3(double(std::numeric_limits<float>::max())));
+    result.total[p] = glm::vec3(clamped);
+    if (clamped != sum) ++result.dropped_samples;
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

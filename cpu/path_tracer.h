@@ -48,7 +48,8 @@ struct RenderResult {
   std::vector<std::vector<glm::vec3>> bounce_images;  // bounces + 1 images, row-major, top row first
   std::vector<glm::vec3> total;
   std::vector<BounceStats> bounces;
-  uint64_t dropped_samples = 0;                       // non-finite contributions left out
+  uint64_t dropped_samples = 0;  // contributions left out as non-finite (or whose sum would be), and
+                                 // total pixels clamped to the float range: images hold no Inf/NaN
   double seconds = 0.0;                               // whole render, shading included
   uint64_t indirect_rays() const;
   double indirect_seconds() const;
