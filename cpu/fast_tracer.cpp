@@ -1,0 +1,273 @@
+#include "fast_tracer.h"
+
+#include "accel.h"
+#include "wide_bvh.h"
+
+#include <xsimd/xsimd.hpp>
+
+#include <bit>
+
+namespace ls {
+
+// The batch the box tests run in: 8 floats with AVX (LINESPACE_ISA=native on these machines), else
+// 4 (SSE2, the portable x86-64 default; NEON on aarch64).  AVX-512's 16 floats would be wider than a
+// 4-wide treelet's 6 boxes, so 8 is the most taken.
+#if XSIMD_WITH_AVX
+using SimdArch = xsimd::avx;
+#elif XSIMD_WITH_SSE2
+using SimdArch = xsimd::sse2;
+#elif XSIMD_WITH_NEON64
+using SimdArch = xsimd::neon64;
+#else
+#error "the fast path needs SSE2, AVX or NEON64 (xsimd)"
+#endif
+using FloatBatch = xsimd::batch<float, SimdArch>;
+
+Traversal parse_traversal(const std::string& text) {
+  if (text == "reference") return Traversal::Reference;
+  if (text == "fast") return Traversal::Fast;
+  throw InputError("traversal '" + text + "' is not reference or fast");
+}
+
+const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" : "reference"; }
+
+std::string fast_path_isa() {
+  return std::string(SimdArch::name()) + " (" + std::to_string(FloatBatch::size) + " floats)";
+}
+
+namespace {
+
+using lsk::Hit;
+using lsk::LS_INVALID;
+using lsk::uint;
+using lsk::vec3;
+
+// glm::min / glm::max lane by lane, NaN behaviour included (y < x ? y : x; x < y ? y : x), so each lane
+// equals lsk::ray_box bit for bit.
+inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(y < x, y, x); }
+inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(x < y, y, x); }
+
+// The per-ray constants of the box tests.
+struct BoxRay {
+  float origin[3];
+  float inv_dir[3];
+  bool parallel[3];  // safe_reciprocal's huge value: the ray runs parallel to that slab
+};
+
+BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
+  constexpr float big = 3.0e38f;
+  BoxRay r;
+  for (int a = 0; a < 3; ++a) {
+    r.origin[a] = origin[a];
+    r.inv_dir[a] = inv_dir[a];
+    r.parallel[a] = std::abs(inv_dir[a]) == big;
+  }
+  return r;
+}
+
+// lsk::ray_box for every lane of a wide node: entry distance and widened exit distance; a lane is hit
+// when tnear <= tfar.  Same operations in the same order as the scalar kernel (slab_interval,
+// widen_distance), and no fused multiply-adds (-ffp-contract=off), hence the same bits.
+template <int K>
+inline void box_tests(const WideNode<K>& node, const BoxRay& r, float tmin, float tmax, float* tnear, float* tfar) {
+  constexpr float big = 3.0e38f;
+  constexpr float slack = 3.81469727e-6f;  // widen_distance's 2^-18
+  for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
+    FloatBatch tn[3];
+    FloatBatch tf[3];
+    for (int a = 0; a < 3; ++a) {
+      const FloatBatch lo = FloatBatch::load_aligned(&node.lo[a][c]);
+      const FloatBatch hi = FloatBatch::load_aligned(&node.hi[a][c]);
+      const FloatBatch o(r.origin[a]);
+      if (r.parallel[a]) {
+        const auto inside = (o >= lo) && (o <= hi);
+        tn[a] = xsimd::select(inside, FloatBatch(-big), FloatBatch(big));
+        tf[a] = xsimd::select(inside, FloatBatch(big), FloatBatch(-big));
+      } else {
+        const FloatBatch inv(r.inv_dir[a]);
+        const FloatBatch t0 = (lo - o) * inv;
+        const FloatBatch t1 = (hi - o) * inv;
+        tn[a] = glm_min(t0, t1);
+        tf[a] = glm_max(t0, t1);
+      }
+    }
+    const FloatBatch near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], FloatBatch(tmin)));
+    const FloatBatch far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], FloatBatch(tmax)));
+    const FloatBatch widened = far + xsimd::abs(far) * FloatBatch(slack);
+    near.store_aligned(tnear + c);
+    widened.store_aligned(tfar + c);
+  }
+}
+
+// What a node visit asks of the traversal.
+enum class Visit { Descend, Skip, Stop };
+
+// The reference's loop (trace_bvh / trace_two_level), node for node, on a wide tree.  Starts at the
+// treelet root of wide node w (its box already tested by the caller).  visit(ls, leaf, first, count)
+// is called for every node the reference visits: an inner node (leaf = false) is descended only on
+// Visit::Descend; Visit::Stop ends the walk and returns true.
+template <int K, class VisitFn>
+inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin, const Hit& hit, VisitFn&& visit) {
+  using Node = WideNode<K>;
+  alignas(64) float tnear[Node::kPadded];
+  alignas(64) float tfar[Node::kPadded];
+  uint cached = LS_INVALID;  // the wide node tnear/tfar hold, computed against cached_t
+  float cached_t = 0.0f;
+  uint stack_w[lsk::TraceContext::LS_STACK_SIZE];
+  uint stack_pos[lsk::TraceContext::LS_STACK_SIZE];
+  float stack_t[lsk::TraceContext::LS_STACK_SIZE];
+  int sp = 0;
+  uint pos = 1;
+  while (true) {
+    const Node& node = tree.nodes[w];
+    const bool root = pos == 1;
+    const uint lane = pos - 2;
+    const bool leaf = !root && node.count[lane] > 0;
+    const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u);
+    if (v == Visit::Stop) return true;
+    if (v == Visit::Descend && !leaf) {
+      // The children's boxes against the current t, as the reference tests them on arrival here.
+      if (cached != w || std::bit_cast<uint32_t>(cached_t) != std::bit_cast<uint32_t>(hit.t)) {
+        box_tests(node, ray, tmin, hit.t, tnear, tfar);
+        cached = w;
+        cached_t = hit.t;
+      }
+      const uint c0 = 2u * pos;
+      const uint c1 = c0 + 1u;
+      const bool hit0 = tnear[c0 - 2u] <= tfar[c0 - 2u];
+      const bool hit1 = tnear[c1 - 2u] <= tfar[c1 - 2u];
+      // A bottom-level inner node continues as the root of its own wide node.
+      auto go = [&](uint c, uint& to_w, uint& to_pos) {
+        if (c >= Node::kBottom && node.count[c - 2u] == 0u) {
+          to_w = node.first[c - 2u];
+          to_pos = 1u;
+        } else {
+          to_w = w;
+          to_pos = c;
+        }
+      };
+      if (hit0 && hit1) {
+        const bool first0 = tnear[c0 - 2u] <= tnear[c1 - 2u];
+        const uint far = first0 ? c1 : c0;
+        go(far, stack_w[sp], stack_pos[sp]);
+        stack_t[sp] = tnear[far - 2u];
+        ++sp;
+        go(first0 ? c0 : c1, w, pos);
+        continue;
+      }
+      if (hit0 || hit1) {
+        go(hit0 ? c0 : c1, w, pos);
+        continue;
+      }
+    }
+    // Pop the nearest pending node that can still hold something closer than the current hit.
+    bool found = false;
+    while (sp > 0 && !found) {
+      --sp;
+      if (stack_t[sp] <= lsk::widen_distance(hit.t)) {
+        w = stack_w[sp];
+        pos = stack_pos[sp];
+        found = true;
+      }
+    }
+    if (!found) return false;
+  }
+}
+
+template <int K>
+class WideTracer final : public FastTracer {
+ public:
+  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()) {
+    const std::vector<uint32_t> none;
+    const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
+    if (two_level_) {
+      objects_ = build_wide_tree<K>(accel.nodes, node_ls, accel.object_roots);
+      top_ = build_wide_tree<K>(accel.top_nodes, none, {0u});
+    } else {
+      objects_ = build_wide_tree<K>(accel.nodes, node_ls, {0u});
+    }
+  }
+
+  void trace(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, bool any_hit) const override {
+    if (two_level_)
+      for (size_t i = 0; i < count; ++i) hits[i] = trace_two_level(c, rays[i], any_hit);
+    else
+      for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], any_hit);
+  }
+
+  size_t bytes() const override { return objects_.bytes() + top_.bytes(); }
+  int width() const override { return 1 << K; }
+
+ private:
+  // lsk::TraceContext::trace_bvh on the wide tree.
+  bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, uint instance,
+                 bool any_hit, bool use_ls, Hit& hit, uint& hit_prim) const {
+    const lsk::TriRay tri_ray = lsk::make_tri_ray(origin, dir);
+    const vec3 inv_dir = lsk::safe_reciprocal(dir);
+    float t_root;
+    if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
+    auto visit = [&](uint ls, bool leaf, uint first, uint count) {
+      if (use_ls && ls != LS_INVALID) {
+        const uint answer = c.ls_lookup(ls, origin, dir, inv_dir, tmin, instance, hit, hit_prim);
+        if (answer == lsk::TraceContext::LS_ACCEPTED && any_hit) return Visit::Stop;
+        if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
+      }
+      if (!leaf) return Visit::Descend;
+      return c.trace_leaf(first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop : Visit::Skip;
+    };
+    const uint w = objects_.wide_of[root];
+    if (w == LS_INVALID) {  // a root that is a leaf has no wide node
+      const lsk::BvhNode& node = c.nodes[root];
+      return visit(use_ls ? c.node_ls[root] : LS_INVALID, true, node.first, node.count) == Visit::Stop;
+    }
+    return walk(objects_, w, make_box_ray(origin, inv_dir), tmin, hit, visit);
+  }
+
+  Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
+    Hit hit = lsk::empty_hit(ray);
+    uint prim = LS_INVALID;
+    trace_bvh(c, 0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, any_hit, c.ls_enabled != 0u, hit, prim);
+    return lsk::finish_hit(hit);
+  }
+
+  Hit trace_two_level(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
+    Hit hit = lsk::empty_hit(ray);
+    uint prim = LS_INVALID;
+    const vec3 inv_dir = lsk::safe_reciprocal(ray.dir);
+    float t_root;
+    if (!lsk::ray_box(ray.origin, inv_dir, ray.tmin, hit.t, c.top_nodes[0].lo, c.top_nodes[0].hi, t_root))
+      return lsk::finish_hit(hit);
+    const bool use_ls = c.ls_enabled != 0u;
+    auto visit = [&](uint, bool leaf, uint first, uint count) {
+      if (!leaf) return Visit::Descend;
+      for (uint i = first; i < first + count; ++i) {
+        const lsk::InstanceRecord& rec = c.instances[i];
+        vec3 o;
+        vec3 d;
+        c.instance_ray(rec, ray.origin, ray.dir, o, d);
+        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, any_hit, use_ls, hit, prim)) return Visit::Stop;
+      }
+      return Visit::Skip;
+    };
+    const uint w = top_.wide_of[0];
+    if (w == LS_INVALID)
+      visit(LS_INVALID, true, c.top_nodes[0].first, c.top_nodes[0].count);
+    else
+      walk(top_, w, make_box_ray(ray.origin, inv_dir), ray.tmin, hit, visit);
+    return lsk::finish_hit(hit);
+  }
+
+  bool two_level_;
+  WideTree<K> objects_;
+  WideTree<K> top_;
+};
+
+}  // namespace
+
+std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width) {
+  if (width == 8) return std::make_shared<WideTracer<3>>(accel);
+  if (width == 4) return std::make_shared<WideTracer<2>>(accel);
+  throw InputError("wide BVH width must be 4 or 8, not " + std::to_string(width));
+}
+
+}  // namespace ls
