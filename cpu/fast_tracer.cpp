@@ -5,7 +5,6 @@
 
 #include <xsimd/xsimd.hpp>
 
-#include <bit>
 
 namespace ls {
 
@@ -42,16 +41,23 @@ using lsk::LS_INVALID;
 using lsk::uint;
 using lsk::vec3;
 
-// glm::min / glm::max lane by lane, NaN behaviour included (y < x ? y : x; x < y ? y : x), so each lane
-// equals lsk::ray_box bit for bit.
+// glm::min / glm::max lane by lane, NaN and signed-zero behaviour included (y < x ? y : x and
+// x < y ? y : x), so each lane equals lsk::ray_box bit for bit.  x86's minps(a, b) is a < b ? a : b
+// and maxps(a, b) is a > b ? a : b: with the operands swapped they are exactly glm's.
+#if XSIMD_WITH_SSE2
+inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::min(y, x); }
+inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::max(y, x); }
+#else
 inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(y < x, y, x); }
 inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(x < y, y, x); }
+#endif
 
 // The per-ray constants of the box tests.
 struct BoxRay {
   float origin[3];
   float inv_dir[3];
   bool parallel[3];  // safe_reciprocal's huge value: the ray runs parallel to that slab
+  bool any_parallel;
 };
 
 BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
@@ -62,6 +68,7 @@ BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
     r.inv_dir[a] = inv_dir[a];
     r.parallel[a] = std::abs(inv_dir[a]) == big;
   }
+  r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
   return r;
 }
 
@@ -79,7 +86,7 @@ inline void box_tests(const WideNode<K>& node, const BoxRay& r, float tmin, floa
       const FloatBatch lo = FloatBatch::load_aligned(&node.lo[a][c]);
       const FloatBatch hi = FloatBatch::load_aligned(&node.hi[a][c]);
       const FloatBatch o(r.origin[a]);
-      if (r.parallel[a]) {
+      if (r.any_parallel && r.parallel[a]) {
         const auto inside = (o >= lo) && (o <= hi);
         tn[a] = xsimd::select(inside, FloatBatch(-big), FloatBatch(big));
         tf[a] = xsimd::select(inside, FloatBatch(big), FloatBatch(-big));
@@ -106,18 +113,28 @@ enum class Visit { Descend, Skip, Stop };
 // treelet root of wide node w (its box already tested by the caller).  visit(ls, leaf, first, count)
 // is called for every node the reference visits: an inner node (leaf = false) is descended only on
 // Visit::Descend; Visit::Stop ends the walk and returns true.
+//
+// Each wide node's boxes are tested once, when the walk enters it, against the current t = h0; later
+// decisions at its inner positions (after a pop, with a smaller current t = h) reuse them.  This is
+// exact: the reference tests tnear <= widen(min(tf, h)), tnear does not depend on t, and widen is
+// monotone, so for h <= h0 that is tnear <= widen(min(tf, h0)) && tnear <= widen(h).  (A NaN tmax is
+// ignored by the reference's min and never changes: the second test is then skipped.)  The walk is
+// depth first, so a node's results sit in the slot of its wide depth until every pending position of
+// it has been popped.
 template <int K, class VisitFn>
 inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin, const Hit& hit, VisitFn&& visit) {
   using Node = WideNode<K>;
-  alignas(64) float tnear[Node::kPadded];
-  alignas(64) float tfar[Node::kPadded];
-  uint cached = LS_INVALID;  // the wide node tnear/tfar hold, computed against cached_t
-  float cached_t = 0.0f;
+  constexpr int kMaxDepth = lsk::TraceContext::LS_STACK_SIZE / K + 1;
+  alignas(64) float tnear[kMaxDepth][Node::kPadded];
+  alignas(64) float tfar[kMaxDepth][Node::kPadded];
+  const bool nan_t = hit.t != hit.t;
   uint stack_w[lsk::TraceContext::LS_STACK_SIZE];
   uint stack_pos[lsk::TraceContext::LS_STACK_SIZE];
+  int stack_depth[lsk::TraceContext::LS_STACK_SIZE];
   float stack_t[lsk::TraceContext::LS_STACK_SIZE];
   int sp = 0;
   uint pos = 1;
+  int depth = 0;
   while (true) {
     const Node& node = tree.nodes[w];
     const bool root = pos == 1;
@@ -126,47 +143,50 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
     const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u);
     if (v == Visit::Stop) return true;
     if (v == Visit::Descend && !leaf) {
-      // The children's boxes against the current t, as the reference tests them on arrival here.
-      if (cached != w || std::bit_cast<uint32_t>(cached_t) != std::bit_cast<uint32_t>(hit.t)) {
-        box_tests(node, ray, tmin, hit.t, tnear, tfar);
-        cached = w;
-        cached_t = hit.t;
-      }
+      if (root) box_tests(node, ray, tmin, hit.t, tnear[depth], tfar[depth]);
+      const float* tn = tnear[depth];
+      const float* tf = tfar[depth];
+      const float limit = lsk::widen_distance(hit.t);
       const uint c0 = 2u * pos;
       const uint c1 = c0 + 1u;
-      const bool hit0 = tnear[c0 - 2u] <= tfar[c0 - 2u];
-      const bool hit1 = tnear[c1 - 2u] <= tfar[c1 - 2u];
-      // A bottom-level inner node continues as the root of its own wide node.
-      auto go = [&](uint c, uint& to_w, uint& to_pos) {
+      const float tn0 = tn[c0 - 2u];
+      const float tn1 = tn[c1 - 2u];
+      const bool hit0 = tn0 <= tf[c0 - 2u] && (nan_t || tn0 <= limit);
+      const bool hit1 = tn1 <= tf[c1 - 2u] && (nan_t || tn1 <= limit);
+      // A bottom-level inner node continues as the root of its own wide node, one wide level down.
+      auto go = [&](uint c, uint& to_w, uint& to_pos, int& to_depth) {
         if (c >= Node::kBottom && node.count[c - 2u] == 0u) {
           to_w = node.first[c - 2u];
           to_pos = 1u;
+          to_depth = depth + 1;
         } else {
           to_w = w;
           to_pos = c;
+          to_depth = depth;
         }
       };
       if (hit0 && hit1) {
-        const bool first0 = tnear[c0 - 2u] <= tnear[c1 - 2u];
-        const uint far = first0 ? c1 : c0;
-        go(far, stack_w[sp], stack_pos[sp]);
-        stack_t[sp] = tnear[far - 2u];
+        const bool first0 = tn0 <= tn1;
+        go(first0 ? c1 : c0, stack_w[sp], stack_pos[sp], stack_depth[sp]);
+        stack_t[sp] = first0 ? tn1 : tn0;
         ++sp;
-        go(first0 ? c0 : c1, w, pos);
+        go(first0 ? c0 : c1, w, pos, depth);
         continue;
       }
       if (hit0 || hit1) {
-        go(hit0 ? c0 : c1, w, pos);
+        go(hit0 ? c0 : c1, w, pos, depth);
         continue;
       }
     }
     // Pop the nearest pending node that can still hold something closer than the current hit.
     bool found = false;
+    const float limit = lsk::widen_distance(hit.t);
     while (sp > 0 && !found) {
       --sp;
-      if (stack_t[sp] <= lsk::widen_distance(hit.t)) {
+      if (stack_t[sp] <= limit) {
         w = stack_w[sp];
         pos = stack_pos[sp];
+        depth = stack_depth[sp];
         found = true;
       }
     }
