@@ -5,6 +5,8 @@
 
 #include <xsimd/xsimd.hpp>
 
+#include <bit>
+
 
 namespace ls {
 
@@ -21,6 +23,16 @@ using SimdArch = xsimd::neon64;
 #error "the fast path needs SSE2, AVX or NEON64 (xsimd)"
 #endif
 using FloatBatch = xsimd::batch<float, SimdArch>;
+
+// Triangles are tested four at a time (a leaf holds at most four, unless they cannot be separated).
+#if XSIMD_WITH_SSE2
+using TriArch = xsimd::sse2;
+#else
+using TriArch = SimdArch;
+#endif
+using Tri4 = xsimd::batch<float, TriArch>;
+using Int4 = xsimd::batch<int32_t, TriArch>;
+static_assert(Tri4::size == 4, "triangle blocks hold four triangles");
 
 Traversal parse_traversal(const std::string& text) {
   if (text == "reference") return Traversal::Reference;
@@ -47,9 +59,11 @@ using lsk::vec3;
 #if XSIMD_WITH_SSE2
 inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::min(y, x); }
 inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::max(y, x); }
+inline Tri4 glm_max4(const Tri4& x, const Tri4& y) { return xsimd::max(y, x); }
 #else
 inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(y < x, y, x); }
 inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(x < y, y, x); }
+inline Tri4 glm_max4(const Tri4& x, const Tri4& y) { return xsimd::select(x < y, y, x); }
 #endif
 
 // The per-ray constants of the box tests.
@@ -106,6 +120,63 @@ inline void box_tests(const WideNode<K>& node, const BoxRay& r, float tmin, floa
   }
 }
 
+// Four triangles of a leaf in SoA layout: v[vertex][axis][lane].  Lanes past the leaf's count are 0.
+struct alignas(16) TriBlock {
+  float v[3][3][4];
+};
+
+// lsk::scale_pow2(x, e) lane by lane for e in [-126, 126] (what unit_exponent returns): x * 2^e is
+// exact unless the result would be denormal, where the kernel flushes to a signed zero instead; a
+// zero, an infinity or a NaN stays itself.  The kernel's two half-steps give the same exact product.
+inline Tri4 scale_pow2_lanes(const Tri4& x, const Int4& e, const Tri4& pow2_e) {
+  const Int4 field = (xsimd::bitwise_cast<Int4>(x) >> 23) & Int4(255);
+  const auto flush = ((field - Int4(127) + e) < Int4(-126)) && (field != Int4(255));
+  const Int4 bits = xsimd::select(flush, xsimd::bitwise_cast<Int4>(x * Tri4(0.0f)), xsimd::bitwise_cast<Int4>(x * pow2_e));
+  return xsimd::bitwise_cast<Tri4>(bits);
+}
+
+inline Tri4 max_abs_lanes(const Tri4& x, const Tri4& y, const Tri4& z) {
+  return glm_max4(glm_max4(xsimd::abs(x), xsimd::abs(y)), xsimd::abs(z));
+}
+
+// The first half of lsk::ray_triangle on four triangles at once: translate, scale by the power of two,
+// shear, edge functions; the same operations lane by lane, hence the same values.  Returns a lane
+// mask (bit l) of the triangles the kernel may hit: those whose edge-function signs do not already
+// reject them, and those with a zero edge function (the kernel then recomputes it in double).  The
+// kernel itself decides these, so a hit is the kernel's hit bit for bit.
+inline unsigned maybe_hit_lanes(const TriBlock& block, const lsk::TriRay& r) {
+  Tri4 d[3][3];  // translated vertices: d[vertex][axis]
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) d[k][a] = Tri4::load_aligned(block.v[k][a]) - Tri4(r.origin[a]);
+  const Tri4 m = glm_max4(glm_max4(max_abs_lanes(d[0][0], d[0][1], d[0][2]), max_abs_lanes(d[1][0], d[1][1], d[1][2])),
+                          max_abs_lanes(d[2][0], d[2][1], d[2][2]));
+  // unit_exponent(m) = clamp(-float_exponent(m), -126, 126); lanes with m == 0 end as zero edges.
+  const Int4 neg_exp = Int4(127) - ((xsimd::bitwise_cast<Int4>(m) >> 23) & Int4(255));
+  const Int4 ks = xsimd::select(neg_exp > Int4(126), Int4(126), xsimd::select(neg_exp < Int4(-126), Int4(-126), neg_exp));
+  const Tri4 pow2_ks = xsimd::bitwise_cast<Tri4>((ks + Int4(127)) << 23);
+  Tri4 sx[3];
+  Tri4 sy[3];
+  const Tri4 shear_x(r.sx);
+  const Tri4 shear_y(r.sy);
+  for (int k = 0; k < 3; ++k) {
+    const Tri4 px = scale_pow2_lanes(d[k][r.kx], ks, pow2_ks);
+    const Tri4 py = scale_pow2_lanes(d[k][r.ky], ks, pow2_ks);
+    const Tri4 pz = scale_pow2_lanes(d[k][r.kz], ks, pow2_ks);
+    sx[k] = px - shear_x * pz;
+    sy[k] = py - shear_y * pz;
+  }
+  const Tri4 eu = sx[2] * sy[1] - sy[2] * sx[1];
+  const Tri4 ev = sx[0] * sy[2] - sy[0] * sx[2];
+  const Tri4 ew = sx[1] * sy[0] - sy[1] * sx[0];
+  const Tri4 zero(0.0f);
+  const auto any_zero = (eu == zero) || (ev == zero) || (ew == zero);
+  const auto rejected = ((eu < zero) || (ev < zero) || (ew < zero)) && ((eu > zero) || (ev > zero) || (ew > zero));
+  const auto maybe = any_zero || !rejected;
+  alignas(16) bool lanes[4];
+  maybe.store_aligned(lanes);
+  return unsigned(lanes[0]) | unsigned(lanes[1]) << 1 | unsigned(lanes[2]) << 2 | unsigned(lanes[3]) << 3;
+}
+
 // What a node visit asks of the traversal.
 enum class Visit { Descend, Skip, Stop };
 
@@ -140,7 +211,8 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
     const bool root = pos == 1;
     const uint lane = pos - 2;
     const bool leaf = !root && node.count[lane] > 0;
-    const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u);
+    const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u,
+                          leaf ? node.block[lane] : LS_INVALID);
     if (v == Visit::Stop) return true;
     if (v == Visit::Descend && !leaf) {
       if (root) box_tests(node, ray, tmin, hit.t, tnear[depth], tfar[depth]);
@@ -206,6 +278,22 @@ class WideTracer final : public FastTracer {
     } else {
       objects_ = build_wide_tree<K>(accel.nodes, node_ls, {0u});
     }
+    // SoA copies of each leaf's triangles, four to a block.
+    for (WideNode<K>& node : objects_.nodes)
+      for (int lane = 0; lane < WideNode<K>::kLanes; ++lane) {
+        if (node.count[lane] == 0) continue;
+        node.block[lane] = uint32_t(blocks_.size());
+        for (uint32_t b = 0; b < node.count[lane]; b += 4) {
+          TriBlock block{};
+          for (uint32_t l = 0; l < 4 && b + l < node.count[lane]; ++l) {
+            const lsk::Triangle& t = accel.tris[node.first[lane] + b + l];
+            const glm::vec4* v[3] = {&t.v0, &t.v1, &t.v2};
+            for (int k = 0; k < 3; ++k)
+              for (int a = 0; a < 3; ++a) block.v[k][a][l] = (*v[k])[a];
+          }
+          blocks_.push_back(block);
+        }
+      }
   }
 
   void trace(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, bool any_hit) const override {
@@ -215,7 +303,7 @@ class WideTracer final : public FastTracer {
       for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], any_hit);
   }
 
-  size_t bytes() const override { return objects_.bytes() + top_.bytes(); }
+  size_t bytes() const override { return objects_.bytes() + top_.bytes() + blocks_.size() * sizeof(TriBlock); }
   int width() const override { return 1 << K; }
 
  private:
@@ -226,19 +314,21 @@ class WideTracer final : public FastTracer {
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
-    auto visit = [&](uint ls, bool leaf, uint first, uint count) {
+    auto visit = [&](uint ls, bool leaf, uint first, uint count, uint block) {
       if (use_ls && ls != LS_INVALID) {
         const uint answer = c.ls_lookup(ls, origin, dir, inv_dir, tmin, instance, hit, hit_prim);
         if (answer == lsk::TraceContext::LS_ACCEPTED && any_hit) return Visit::Stop;
         if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
       }
       if (!leaf) return Visit::Descend;
-      return c.trace_leaf(first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop : Visit::Skip;
+      const bool stop = block == LS_INVALID ? c.trace_leaf(first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim)
+                                            : trace_leaf(c, block, first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim);
+      return stop ? Visit::Stop : Visit::Skip;
     };
     const uint w = objects_.wide_of[root];
     if (w == LS_INVALID) {  // a root that is a leaf has no wide node
       const lsk::BvhNode& node = c.nodes[root];
-      return visit(use_ls ? c.node_ls[root] : LS_INVALID, true, node.first, node.count) == Visit::Stop;
+      return visit(use_ls ? c.node_ls[root] : LS_INVALID, true, node.first, node.count, LS_INVALID) == Visit::Stop;
     }
     return walk(objects_, w, make_box_ray(origin, inv_dir), tmin, hit, visit);
   }
@@ -258,7 +348,7 @@ class WideTracer final : public FastTracer {
     if (!lsk::ray_box(ray.origin, inv_dir, ray.tmin, hit.t, c.top_nodes[0].lo, c.top_nodes[0].hi, t_root))
       return lsk::finish_hit(hit);
     const bool use_ls = c.ls_enabled != 0u;
-    auto visit = [&](uint, bool leaf, uint first, uint count) {
+    auto visit = [&](uint, bool leaf, uint first, uint count, uint) {
       if (!leaf) return Visit::Descend;
       for (uint i = first; i < first + count; ++i) {
         const lsk::InstanceRecord& rec = c.instances[i];
@@ -271,15 +361,42 @@ class WideTracer final : public FastTracer {
     };
     const uint w = top_.wide_of[0];
     if (w == LS_INVALID)
-      visit(LS_INVALID, true, c.top_nodes[0].first, c.top_nodes[0].count);
+      visit(LS_INVALID, true, c.top_nodes[0].first, c.top_nodes[0].count, LS_INVALID);
     else
       walk(top_, w, make_box_ray(ray.origin, inv_dir), ray.tmin, hit, visit);
     return lsk::finish_hit(hit);
   }
 
+  // lsk::TraceContext::trace_leaf with the four-lane filter in front: the triangles it cannot rule
+  // out go through the kernel's ray_triangle and offer_hit in the leaf's order, as in the reference.
+  bool trace_leaf(lsk::TraceContext& c, uint block, uint first, uint count, const lsk::TriRay& tri_ray, float tmin,
+                  uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
+    for (uint b = 0; b < count; b += 4u) {
+      unsigned maybe = maybe_hit_lanes(blocks_[block + b / 4u], tri_ray);
+      if (count - b < 4u) maybe &= (1u << (count - b)) - 1u;
+      while (maybe != 0u) {
+        const uint i = first + b + uint(std::countr_zero(maybe));
+        maybe &= maybe - 1u;
+        const lsk::Triangle& tri = c.tris[i];
+        float t;
+        float u;
+        float v;
+        if (lsk::ray_triangle(tri_ray, tmin, hit.t, vec3(tri.v0), vec3(tri.v1), vec3(tri.v2), t, u, v)) {
+          const uint inst = instance == LS_INVALID ? c.tri_instances[i] : instance;
+          if (lsk::offer_hit(t, u, v, inst, c.tri_ids[i], hit)) {
+            hit_prim = i;
+            if (any_hit) return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
   bool two_level_;
   WideTree<K> objects_;
   WideTree<K> top_;
+  std::vector<TriBlock> blocks_;
 };
 
 }  // namespace

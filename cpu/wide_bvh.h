@@ -37,6 +37,7 @@ struct alignas(64) WideNode {
   uint32_t first[kLanes];   // leaf: first triangle / instance; bottom-level inner node: its wide node
   uint32_t count[kLanes];   // leaf: primitive count; 0: inner node (or an unused lane)
   uint32_t ls[kLanes];      // the node's LsNode, or LS_INVALID
+  uint32_t block[kLanes];   // triangle leaf: its first 4-triangle SoA block (set by the fast tracer)
   uint32_t root_ls;         // the treelet root's LsNode, or LS_INVALID
 };
 
