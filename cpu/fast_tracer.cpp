@@ -192,8 +192,9 @@ enum class Visit { Descend, Skip, Stop };
 // ignored by the reference's min and never changes: the second test is then skipped.)  The walk is
 // depth first, so a node's results sit in the slot of its wide depth until every pending position of
 // it has been popped.
-template <int K, class VisitFn>
-inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin, const Hit& hit, VisitFn&& visit) {
+template <int K, class VisitFn, class PrefetchFn>
+inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin, const Hit& hit, VisitFn&& visit,
+                 PrefetchFn&& prefetch_leaf) {
   using Node = WideNode<K>;
   constexpr int kMaxDepth = lsk::TraceContext::LS_STACK_SIZE / K + 1;
   alignas(64) float tnear[kMaxDepth][Node::kPadded];
@@ -215,7 +216,19 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
                           leaf ? node.block[lane] : LS_INVALID);
     if (v == Visit::Stop) return true;
     if (v == Visit::Descend && !leaf) {
-      if (root) box_tests(node, ray, tmin, hit.t, tnear[depth], tfar[depth]);
+      if (root) {
+        box_tests(node, ray, tmin, hit.t, tnear[depth], tfar[depth]);
+        // Start loading what the boxes say may come next: the traversal is bound by memory latency.
+        for (uint p = Node::kBottom; p < 2u * Node::kBottom; ++p) {
+          const uint l = p - 2u;
+          if (!(tnear[depth][l] <= tfar[depth][l])) continue;
+          const char* next = node.count[l] == 0u ? reinterpret_cast<const char*>(&tree.nodes[node.first[l]])
+                                                 : prefetch_leaf(node.block[l]);
+          const size_t bytes = node.count[l] == 0u ? sizeof(Node) : sizeof(TriBlock);
+          if (next)
+            for (size_t line = 0; line < bytes; line += 64) __builtin_prefetch(next + line);
+        }
+      }
       const float* tn = tnear[depth];
       const float* tf = tfar[depth];
       const float limit = lsk::widen_distance(hit.t);
@@ -330,7 +343,8 @@ class WideTracer final : public FastTracer {
       const lsk::BvhNode& node = c.nodes[root];
       return visit(use_ls ? c.node_ls[root] : LS_INVALID, true, node.first, node.count, LS_INVALID) == Visit::Stop;
     }
-    return walk(objects_, w, make_box_ray(origin, inv_dir), tmin, hit, visit);
+    auto leaf_block = [&](uint block) { return reinterpret_cast<const char*>(&blocks_[block]); };
+    return walk(objects_, w, make_box_ray(origin, inv_dir), tmin, hit, visit, leaf_block);
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
@@ -363,7 +377,7 @@ class WideTracer final : public FastTracer {
     if (w == LS_INVALID)
       visit(LS_INVALID, true, c.top_nodes[0].first, c.top_nodes[0].count, LS_INVALID);
     else
-      walk(top_, w, make_box_ray(ray.origin, inv_dir), ray.tmin, hit, visit);
+      walk(top_, w, make_box_ray(ray.origin, inv_dir), ray.tmin, hit, visit, [](uint) { return static_cast<const char*>(nullptr); });
     return lsk::finish_hit(hit);
   }
 
@@ -377,11 +391,16 @@ class WideTracer final : public FastTracer {
       while (maybe != 0u) {
         const uint i = first + b + uint(std::countr_zero(maybe));
         maybe &= maybe - 1u;
-        const lsk::Triangle& tri = c.tris[i];
+        const TriBlock& blk = blocks_[block + b / 4u];
+        const uint l = i - first - b;
+        // The block holds the very floats of tris[i]: no second memory stream for the survivors.
+        const vec3 p0(blk.v[0][0][l], blk.v[0][1][l], blk.v[0][2][l]);
+        const vec3 p1(blk.v[1][0][l], blk.v[1][1][l], blk.v[1][2][l]);
+        const vec3 p2(blk.v[2][0][l], blk.v[2][1][l], blk.v[2][2][l]);
         float t;
         float u;
         float v;
-        if (lsk::ray_triangle(tri_ray, tmin, hit.t, vec3(tri.v0), vec3(tri.v1), vec3(tri.v2), t, u, v)) {
+        if (lsk::ray_triangle(tri_ray, tmin, hit.t, p0, p1, p2, t, u, v)) {
           const uint inst = instance == LS_INVALID ? c.tri_instances[i] : instance;
           if (lsk::offer_hit(t, u, v, inst, c.tri_ids[i], hit)) {
             hit_prim = i;
