@@ -3,6 +3,7 @@
 #include "accel.h"
 #include "wide_bvh.h"
 
+#include <tbb/parallel_for.h>
 #include <xsimd/xsimd.hpp>
 
 #include <bit>
@@ -291,22 +292,26 @@ class WideTracer final : public FastTracer {
     } else {
       objects_ = build_wide_tree<K>(accel.nodes, node_ls, {0u});
     }
-    // SoA copies of each leaf's triangles, four to a block.
+    // SoA copies of each leaf's triangles, four to a block: offsets first, then filled in parallel.
+    size_t total = 0;
     for (WideNode<K>& node : objects_.nodes)
-      for (int lane = 0; lane < WideNode<K>::kLanes; ++lane) {
-        if (node.count[lane] == 0) continue;
-        node.block[lane] = uint32_t(blocks_.size());
-        for (uint32_t b = 0; b < node.count[lane]; b += 4) {
-          TriBlock block{};
-          for (uint32_t l = 0; l < 4 && b + l < node.count[lane]; ++l) {
-            const lsk::Triangle& t = accel.tris[node.first[lane] + b + l];
-            const glm::vec4* v[3] = {&t.v0, &t.v1, &t.v2};
-            for (int k = 0; k < 3; ++k)
-              for (int a = 0; a < 3; ++a) block.v[k][a][l] = (*v[k])[a];
-          }
-          blocks_.push_back(block);
+      for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
+        if (node.count[lane] > 0) {
+          node.block[lane] = uint32_t(total);
+          total += (node.count[lane] + 3u) / 4u;
         }
-      }
+    blocks_.assign(total, TriBlock{});
+    tbb::parallel_for(size_t(0), objects_.nodes.size(), [&](size_t n) {
+      const WideNode<K>& node = objects_.nodes[n];
+      for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
+        for (uint32_t k = 0; k < node.count[lane]; ++k) {
+          const lsk::Triangle& t = accel.tris[node.first[lane] + k];
+          TriBlock& block = blocks_[node.block[lane] + k / 4u];
+          const glm::vec4* v[3] = {&t.v0, &t.v1, &t.v2};
+          for (int i = 0; i < 3; ++i)
+            for (int a = 0; a < 3; ++a) block.v[i][a][k % 4u] = (*v[i])[a];
+        }
+    });
   }
 
   void trace(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, bool any_hit) const override {

@@ -61,6 +61,8 @@ void print_build(const Accel& a, bool json) {
                      {"bytes_ls_candidates_compact", a.ls_info.candidate_bytes_compact},
                      {"ls_build_seconds", a.ls_info.seconds},
                      {"ls_shafts_per_second", a.ls_info.seconds > 0.0 ? double(a.ls_info.ls_nodes * a.ls_info.shafts_per_ls) / a.ls_info.seconds : 0.0},
+                     {"bytes_wide", a.bytes_wide()},
+                     {"wide_build_seconds", a.wide_build_seconds},
                      {"build_seconds", a.build_seconds}};
     std::cout << j.dump(2) << "\n";
     return;
