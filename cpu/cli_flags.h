@@ -44,8 +44,14 @@ struct LsFlags {
   std::string candidates = "compact";
   double max_memory_mb = 0.0;
   bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
+  std::string traversal = "fast";
+  int wide_width = AccelOptions{}.wide_width;
 
   void add_to(CLI::App* app) {
+    app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
+        ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
+    app->add_option("--wide-width", wide_width, "children per node of the fast path's wide BVH")
+        ->capture_default_str()->check(CLI::IsMember({4, 8}));
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
@@ -64,6 +70,8 @@ struct LsFlags {
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
     o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    o.traversal = parse_traversal(traversal);
+    o.wide_width = wide_width;
     if (progress)
       o.ls.progress = [](size_t done, size_t total) {
         std::fprintf(stderr, "\rline space: %zu/%zu LS nodes%s", done, total, done == total ? "\n" : "");

@@ -122,7 +122,12 @@ std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const
 
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
                     const Progress& progress, const BatchTracer& tracer) {
-  const BatchTracer trace_batch = tracer ? tracer : BatchTracer(trace_rays);
+  // The first trace_rays overload: each structure's own traversal (accel.traversal).
+  const BatchTracer trace_batch =
+      tracer ? tracer
+             : BatchTracer([](const Accel& a, const lsk::Ray* r, lsk::Hit* h, size_t n, bool any, lsk::LsCounters* c) {
+                 trace_rays(a, r, h, n, any, c);
+               });
   const auto start = std::chrono::steady_clock::now();
   const uint32_t pixels = options.width * options.height;
   const int bounces = options.bounces;
