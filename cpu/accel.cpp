@@ -1,10 +1,12 @@
 #include "accel.h"
 
+#include "memory_budget.h"
+
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
-#include <mutex>
 
 namespace ls {
 namespace {
@@ -145,6 +147,8 @@ size_t Accel::bytes_ls() const {
          ls_candidates.size() * sizeof(uint32_t) + tri_normals.size() * sizeof(glm::uvec4);
 }
 
+size_t Accel::bytes_wide() const { return fast ? fast->bytes() : 0; }
+
 size_t Accel::bytes_total() const {
   return nodes.size() * sizeof(lsk::BvhNode) + tris.size() * sizeof(lsk::Triangle) +
          tri_ids.size() * sizeof(uint32_t) + tri_instances.size() * sizeof(uint32_t) +
@@ -173,6 +177,8 @@ lsk::TraceContext Accel::context() const {
 }
 
 Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) {
+  // Refuse from the scene and parameters alone, before any large allocation (memory_budget.h).
+  check_structure_budget(scene, spec, options.ls);
   const auto start = std::chrono::steady_clock::now();
   Accel accel;
   accel.spec = spec;
@@ -186,6 +192,10 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
     if (options.search_candidates) build_line_space(scene, options.ls, accel);
     else layout_line_space(scene, options.ls, accel);
   }
+  const auto wide_start = std::chrono::steady_clock::now();
+  accel.fast = make_fast_tracer(accel, options.wide_width);
+  accel.traversal = options.traversal;
+  accel.wide_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wide_start).count();
   accel.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return accel;
 }
@@ -212,16 +222,25 @@ void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from) {
 
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters) {
+  trace_rays(accel, rays, hits, count, any_hit, counters, accel.traversal);
+}
+
+void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+                lsk::LsCounters* counters, Traversal traversal) {
   const lsk::TraceContext context = accel.context();
-  std::mutex mutex;
+  const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
+  // Per-thread counters, summed once at the end: no lock on the hot path.
+  tbb::enumerable_thread_specific<lsk::LsCounters> per_thread(lsk::LsCounters{});
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
     lsk::TraceContext local = context;
-    for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray_counted(local, accel, rays[i], any_hit);
-    if (counters && accel.spec.line_space()) {
-      std::lock_guard<std::mutex> lock(mutex);
-      add_counters(*counters, local.ls_counters);
-    }
+    if (fast)
+      fast->trace(local, rays + r.begin(), hits + r.begin(), r.size(), any_hit);
+    else
+      for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray_counted(local, accel, rays[i], any_hit);
+    if (counters && accel.spec.line_space()) add_counters(per_thread.local(), local.ls_counters);
   });
+  if (counters)
+    for (const lsk::LsCounters& c : per_thread) add_counters(*counters, c);
 }
 
 }  // namespace ls

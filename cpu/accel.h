@@ -4,12 +4,14 @@
 #pragma once
 
 #include "bvh_builder.h"
+#include "fast_tracer.h"
 #include "line_space_builder.h"
 #include "scene.h"
 #include "structure_name.h"
 #include "trace_context.h"
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace ls {
@@ -38,7 +40,14 @@ struct Accel {
   LsOptions ls_options;
   LsBuildInfo ls_info;
 
+  // The fast CPU path (fast_tracer.h): the wide BVH over the arrays above, and which path trace_rays
+  // takes by default.  Both give the same answers; the reference is the GPU's twin.
+  std::shared_ptr<const FastTracer> fast;
+  Traversal traversal = Traversal::Fast;
+  double wide_build_seconds = 0.0;          // part of build_seconds
+
   size_t bytes_total() const;
+  size_t bytes_wide() const;                // the fast path's wide nodes (beside bytes_total)
   size_t bytes_ls() const;
   lsk::TraceContext context() const;
 };
@@ -47,6 +56,8 @@ struct AccelOptions {
   BvhBuildOptions bvh;
   LsOptions ls;
   bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
+  Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
+  int wide_width = 4;                     // 4 or 8: chosen by measurement (docs/performance.md)
   AccelOptions() = default;
   AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
 };
@@ -58,9 +69,12 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
 lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 
-// Traces a batch on all threads (TBB); Line Space counters are added to *counters when given.
+// Traces a batch on all threads (TBB) with accel.traversal; Line Space counters are added to *counters
+// when given.  The second form names the traversal (bench and tests run both on one structure).
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters = nullptr);
+void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+                lsk::LsCounters* counters, Traversal traversal);
 
 void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from);
 

@@ -24,22 +24,28 @@ std::string cpu_model() {
 }
 
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats, const AccelOptions& options) {
+                      int repeats, const AccelOptions& options, bool any_hit) {
   BenchResult result;
   result.rays = rays.size();
   result.threads = tbb::info::default_concurrency();
   result.repeats = std::max(1, repeats);
   result.cpu = cpu_model();
+  result.isa = fast_path_isa();
+  result.wide_width = options.wide_width;
+  result.any_hit = any_hit;
 
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) built.push_back(build_accel(scene, spec, options));
   EmbreeTracer embree(scene);
 
+  // Runs: per structure the fast path, then the reference; Embree last.
   std::vector<lsk::Hit> hits(rays.size());
   std::vector<std::function<void()>> runs;
-  for (const Accel& accel : built)
-    runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), false); });
-  runs.push_back([&] { embree.trace(rays.data(), hits.data(), rays.size(), false); });
+  for (const Accel& accel : built) {
+    runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, Traversal::Fast); });
+    runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, Traversal::Reference); });
+  }
+  runs.push_back([&] { embree.trace(rays.data(), hits.data(), rays.size(), any_hit); });
 
   std::vector<std::vector<double>> seconds(runs.size());
   for (auto& run : runs) run();  // warm caches and thread pools once
@@ -49,21 +55,38 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
       runs[i]();
       seconds[i].push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
-  auto median = [](std::vector<double> v) {
+  auto mrays = [&](size_t run) {
+    std::vector<double> v = seconds[run];
     std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
+    return double(rays.size()) / v[v.size() / 2] * 1e-6;
   };
-  for (size_t i = 0; i < runs.size(); ++i) {
+  for (size_t i = 0; i < built.size(); ++i) {
     BenchEntry e;
-    const bool is_embree = i == built.size();
-    e.structure = is_embree ? "embree" : built[i].spec.name();
-    e.mrays_per_s = double(rays.size()) / median(seconds[i]) * 1e-6;
-    e.bytes = is_embree ? embree.bytes() : built[i].bytes_total();
-    e.build_seconds = is_embree ? embree.build_seconds() : built[i].build_seconds;
+    e.structure = built[i].spec.name();
+    e.mrays_per_s = mrays(2 * i);
+    e.reference_mrays_per_s = mrays(2 * i + 1);
+    e.bytes = built[i].bytes_total();
+    e.bytes_wide = built[i].bytes_wide();
+    e.build_seconds = built[i].build_seconds;
     result.results.push_back(e);
   }
-  const double embree_speed = result.results.back().mrays_per_s;
-  for (BenchEntry& e : result.results) e.ratio_vs_embree = embree_speed > 0.0 ? e.mrays_per_s / embree_speed : 0.0;
+  BenchEntry em;
+  em.structure = "embree";
+  em.mrays_per_s = mrays(runs.size() - 1);
+  em.bytes = embree.bytes();
+  em.build_seconds = embree.build_seconds();
+  result.results.push_back(em);
+
+  const double embree_speed = em.mrays_per_s;
+  double fast_bvh = 0.0;
+  for (const BenchEntry& e : result.results)
+    if (e.structure == "bvh") fast_bvh = e.mrays_per_s;
+  for (BenchEntry& e : result.results) {
+    e.ratio_vs_embree = embree_speed > 0.0 ? e.mrays_per_s / embree_speed : 0.0;
+    if (e.structure == "embree") continue;
+    e.reference_ratio_vs_embree = embree_speed > 0.0 ? e.reference_mrays_per_s / embree_speed : 0.0;
+    e.ratio_vs_fast_bvh = fast_bvh > 0.0 ? e.mrays_per_s / fast_bvh : 0.0;
+  }
   return result;
 }
 

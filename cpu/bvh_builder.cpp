@@ -1,5 +1,7 @@
 #include "bvh_builder.h"
 
+#include "interrupt.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
@@ -183,6 +185,7 @@ class Builder {
       }
     }
     if (n > kParallelRange) {
+      throw_if_interrupted();  // large subtrees only: the check costs nothing beside their work
       tbb::parallel_invoke([&] { node->left = build(begin, mid, depth + 1); },
                            [&] { node->right = build(mid, end, depth + 1); });
     } else {

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <string>
 
 namespace ls {
@@ -42,8 +43,15 @@ struct LsFlags {
   uint32_t min_triangles = LsOptions{}.min_triangles;
   std::string candidates = "compact";
   double max_memory_mb = 0.0;
+  bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
+  std::string traversal = "fast";
+  int wide_width = AccelOptions{}.wide_width;
 
   void add_to(CLI::App* app) {
+    app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
+        ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
+    app->add_option("--wide-width", wide_width, "children per node of the fast path's wide BVH")
+        ->capture_default_str()->check(CLI::IsMember({4, 8}));
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
@@ -52,7 +60,7 @@ struct LsFlags {
         ->capture_default_str();
     app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
         ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
-    app->add_option("--max-memory", max_memory_mb, "refuse a Line Space estimated above this many MB (0: half of RAM)")
+    app->add_option("--max-memory", max_memory_mb, "refuse a structure or render estimated above this many MB (0: half of RAM)")
         ->check(CLI::Range(0.0, 1e9));
   }
   AccelOptions options() const {
@@ -62,6 +70,12 @@ struct LsFlags {
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
     o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    o.traversal = parse_traversal(traversal);
+    o.wide_width = wide_width;
+    if (progress)
+      o.ls.progress = [](size_t done, size_t total) {
+        std::fprintf(stderr, "\rline space: %zu/%zu LS nodes%s", done, total, done == total ? "\n" : "");
+      };
     return o;
   }
 };

@@ -25,6 +25,8 @@ void print_build(const Accel& a, bool json, const std::string& device) {
                      {"bytes_ls_candidates_compact", a.ls_info.candidate_bytes_compact},
                      {"ls_build_seconds", a.ls_info.seconds},
                      {"ls_shafts_per_second", a.ls_info.seconds > 0.0 ? double(a.ls_info.ls_nodes * a.ls_info.shafts_per_ls) / a.ls_info.seconds : 0.0},
+                     {"bytes_wide", a.bytes_wide()},
+                     {"wide_build_seconds", a.wide_build_seconds},
                      {"build_seconds", a.build_seconds}};
     if (!device.empty()) j["device"] = device;
     std::cout << j.dump(2) << "\n";

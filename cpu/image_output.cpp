@@ -1,5 +1,6 @@
 #include "image_output.h"
 
+#include "interrupt.h"
 #include "scene.h"
 
 #include <OpenImageIO/imageio.h>
@@ -13,14 +14,21 @@ namespace ls {
 namespace {
 
 void write_pixels(const std::string& path, uint32_t width, uint32_t height, OIIO::TypeDesc type, const void* data) {
+  throw_if_interrupted();  // no output file is begun once an interrupt is pending
   const std::string temp = path + ".partial" + std::filesystem::path(path).extension().string();
   auto out = OIIO::ImageOutput::create(temp);
   if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
   OIIO::ImageSpec spec(int(width), int(height), 3, type);
   if (type == OIIO::TypeDesc::FLOAT) spec.attribute("compression", "zip");
-  if (!out->open(temp, spec) || !out->write_image(type, data) || !out->close())
+  set_partial_file(&temp);
+  if (!out->open(temp, spec) || !out->write_image(type, data) || !out->close()) {
+    set_partial_file(nullptr);
+    std::error_code ec;
+    std::filesystem::remove(temp, ec);
     throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
+  }
   std::filesystem::rename(temp, path);
+  set_partial_file(nullptr);
 }
 
 float srgb(float linear) {

@@ -1,6 +1,7 @@
 #include "line_space_builder.h"
 
 #include "accel.h"
+#include "interrupt.h"
 
 #include <glm/gtc/packing.hpp>
 #include <tbb/parallel_for.h>
@@ -11,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 namespace ls {
 namespace {
@@ -197,16 +199,23 @@ void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel
   context.ls_enabled = 0;
   const float inv_n = 1.0f / float(n);
   const uint32_t instance = ls_search_instance(accel);
-  std::atomic<size_t> empty{0};
+  std::atomic<size_t> empty{0}, nodes_done{0};
+  std::mutex progress_mutex;
   tbb::parallel_for(size_t(0), accel.ls_nodes.size(), [&](size_t li) {
     const lsk::LsNode ls = accel.ls_nodes[li];
     std::vector<uint32_t> prims(shafts);
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
+      throw_if_interrupted();  // TBB cancels the other blocks and rethrows in the caller
       lsk::TraceContext c = context;
       for (uint32_t s = r.begin(); s != r.end(); ++s)
         prims[s] = c.ls_find_candidate(ls.node, ls, s, n, inv_n, uint32_t(options.further_rays), instance);
     });
     empty += pack_ls_candidates(accel, li, prims.data());  // nodes own disjoint words
+    const size_t done = ++nodes_done;
+    if (options.progress && progress_mutex.try_lock()) {  // never wait: a busy reporter skips a tick
+      options.progress(done, accel.ls_nodes.size());
+      progress_mutex.unlock();
+    }
   });
 
   accel.ls_info.empty_shafts = empty.load();

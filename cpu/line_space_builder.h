@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace ls {
@@ -22,6 +23,8 @@ struct LsOptions {
   uint32_t min_triangles = 8;    // subtrees with fewer triangles get no LS (0: the paper's behaviour)
   bool paper_candidates = false; // 4-byte candidates instead of the compact 1/2/4-byte local index
   size_t max_memory = 0;         // refuse above this estimate (0: half of physical memory)
+  // Called now and then from the building threads with (LS nodes done, LS nodes): a progress bar.
+  std::function<void(size_t done, size_t total)> progress;
 };
 
 struct LsBuildInfo {

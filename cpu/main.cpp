@@ -4,7 +4,9 @@
 #include "cli_flags.h"
 #include "cli_report.h"
 #include "bench.h"
+#include "interrupt.h"
 #include "load_scene.h"
+#include "memory_budget.h"
 #include "path_tracer.h"
 #include "ray_files.h"
 #include "ray_generators.h"
@@ -24,28 +26,49 @@ using namespace ls;
 void print_bench(const BenchResult& r, bool json) {
   if (json) {
     nlohmann::json results = nlohmann::json::array();
-    for (const BenchEntry& e : r.results)
-      results.push_back({{"structure", e.structure},
-                         {"mrays_per_s", e.mrays_per_s},
-                         {"ratio_vs_embree", e.ratio_vs_embree},
-                         {"bytes", e.bytes},
-                         {"build_seconds", e.build_seconds}});
+    for (const BenchEntry& e : r.results) {
+      nlohmann::json j{{"structure", e.structure},
+                       {"mrays_per_s", e.mrays_per_s},
+                       {"ratio_vs_embree", e.ratio_vs_embree},
+                       {"bytes", e.bytes},
+                       {"build_seconds", e.build_seconds}};
+      if (e.structure != "embree") {
+        j["traversal"] = "fast";
+        j["reference_mrays_per_s"] = e.reference_mrays_per_s;
+        j["reference_ratio_vs_embree"] = e.reference_ratio_vs_embree;
+        j["ratio_vs_fast_bvh"] = e.ratio_vs_fast_bvh;
+        j["bytes_wide"] = e.bytes_wide;
+      }
+      results.push_back(j);
+    }
     std::cout << nlohmann::json{{"rays", r.rays}, {"threads", r.threads}, {"repeats", r.repeats}, {"device", "cpu: " + r.cpu},
-                                {"results", results}}
+                                {"isa", r.isa}, {"wide_width", r.wide_width}, {"any_hit", r.any_hit}, {"results", results}}
                      .dump(2)
               << "\n";
     return;
   }
-  std::printf("%zu rays, %d threads, median of %d runs, %s\n", r.rays, r.threads, r.repeats, r.cpu.c_str());
-  std::printf("%-14s %12s %10s %12s %10s\n", "structure", "MRays/s", "vs Embree", "MB", "build s");
-  for (const BenchEntry& e : r.results)
-    std::printf("%-14s %12.2f %9.2fx %12.2f %10.3f\n", e.structure.c_str(), e.mrays_per_s, e.ratio_vs_embree,
-                double(e.bytes) / 1e6, e.build_seconds);
+  std::printf("%zu rays (%s), %d threads, median of %d runs, %s\n", r.rays, r.any_hit ? "any hit" : "closest hit",
+              r.threads, r.repeats, r.cpu.c_str());
+  std::printf("fast path: %d-wide BVH, %s; reference: the scalar single-source kernels\n", r.wide_width, r.isa.c_str());
+  std::printf("%-14s %10s %10s %10s %10s %9s %10s %9s %9s\n", "structure", "fast MR/s", "vs Embree", "vs bvh", "ref MR/s",
+              "ref vs E", "fast/ref", "MB", "build s");
+  for (const BenchEntry& e : r.results) {
+    if (e.structure == "embree") {
+      std::printf("%-14s %10.2f %9.2fx %10s %10s %9s %10s %9.2f %9.3f\n", e.structure.c_str(), e.mrays_per_s,
+                  e.ratio_vs_embree, "", "", "", "", double(e.bytes) / 1e6, e.build_seconds);
+      continue;
+    }
+    std::printf("%-14s %10.2f %9.2fx %9.2fx %10.2f %8.2fx %9.2fx %9.2f %9.3f\n", e.structure.c_str(), e.mrays_per_s,
+                e.ratio_vs_embree, e.ratio_vs_fast_bvh, e.reference_mrays_per_s, e.reference_ratio_vs_embree,
+                e.reference_mrays_per_s > 0.0 ? e.mrays_per_s / e.reference_mrays_per_s : 0.0,
+                double(e.bytes + e.bytes_wide) / 1e6, e.build_seconds);
+  }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_interrupt_handlers();  // Ctrl-C: stop cleanly, exit 130, no output file half-written
   CLI::App app{"linespace-cpu: exact and Line Space ray tracing, CPU reference"};
   app.require_subcommand(1);
   std::string scene_spec = "builtin:cornell";
@@ -74,7 +97,7 @@ int main(int argc, char** argv) {
   uint32_t seed = 1;
   auto* rays = app.add_subcommand("rays", "write a ray file");
   rays->add_option("--scene", scene_spec)->capture_default_str();
-  rays->add_option("--kind", kind, "primary, diffuse or random")->capture_default_str();
+  rays->add_option("--kind", kind, "primary, diffuse, random or shadow")->capture_default_str();
   rays->add_option("--count", count)->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
   rays->add_option("--seed", seed)->capture_default_str();
   rays->add_option("--out", out_path, "ray file to write")->required();
@@ -99,7 +122,12 @@ int main(int argc, char** argv) {
   ls_flags.add_to(bench);
   bench->add_option("--scene", scene_spec)->capture_default_str();
   bench->add_option("--rays", rays_path, "ray file (default: diffuse rays made here)");
-  bench->add_option("--count", count, "diffuse rays to make when --rays is not given")->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
+  std::string bench_kind = "diffuse";
+  bench->add_option("--kind", bench_kind, "rays to make when --rays is not given: diffuse, primary, random, or shadow (any hit)")
+      ->capture_default_str()->check(CLI::IsMember({"diffuse", "primary", "random", "shadow"}));
+  bool bench_any_hit = false;
+  bench->add_flag("--any-hit", bench_any_hit, "occlusion queries (implied by --kind shadow)");
+  bench->add_option("--count", count, "rays to make when --rays is not given")->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
   bench->add_option("--seed", seed)->capture_default_str();
   bench->add_option("--structures", structures, "comma-separated structures")->capture_default_str();
   bench->add_option("--repeat", repeats, "timed runs per structure (median reported)")->capture_default_str()->check(CLI::Range(1, 100));
@@ -114,6 +142,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  ls_flags.progress = isatty(2) && !quiet;
   try {
     const Scene scene = load_scene(scene_spec);
     if (*build) {
@@ -144,6 +173,7 @@ int main(int argc, char** argv) {
       options.spp = spp;
       options.bounces = bounces;
       options.seed = seed;
+      check_render_budget(options.width, options.height, bounces, ls_flags.options().ls.max_memory);
       std::map<std::string, Accel> built = build_schedule_structures(scene, options.schedule, ls_flags.options());
       const bool show = !quiet && isatty(2);
       Progress progress = [&](int done, int total) {
@@ -170,11 +200,15 @@ int main(int argc, char** argv) {
         bench_rays = read_rays(rays_path);
       } else {
         const Accel exact = build_accel(scene, parse_structure("bvh"));
-        bench_rays = generate_rays(scene, exact, RayKind::Diffuse, count, seed);
+        bench_rays = generate_rays(scene, exact, parse_ray_kind(bench_kind), count, seed);
       }
       if (bench_rays.empty()) throw InputError("bench: the ray file holds no rays");
-      print_bench(run_bench(scene, bench_rays, specs, repeats, ls_flags.options()), json);
+      const bool occlusion = bench_any_hit || (rays_path.empty() && bench_kind == "shadow");
+      print_bench(run_bench(scene, bench_rays, specs, repeats, ls_flags.options(), occlusion), json);
     }
+  } catch (const Interrupted& e) {
+    std::cerr << "\nlinespace-cpu: " << e.what() << ", stopped (no partially written output file is left)\n";
+    return 128 + interrupt_signal();
   } catch (const InputError& e) {
     std::cerr << "linespace-cpu: " << e.what() << "\n";
     return 2;

@@ -1,6 +1,8 @@
 #include "path_tracer.h"
 
+#include "interrupt.h"
 #include "kernels/sampling.h"
+#include "kernels/scaled_geometry.h"
 #include "surface.h"
 
 #include <tbb/parallel_for.h>
@@ -8,10 +10,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace ls {
 
-LightSet::LightSet(const Scene& scene, const SurfaceLookup& surfaces) {
+LightSet::LightSet(const Scene& scene, const SurfaceLookup& surfaces) : unit_k(lsk::unit_exponent(surfaces.scene_scale())) {
   std::vector<double> power;
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
     const Mesh& mesh = scene.meshes[scene.instances[i].mesh];
@@ -21,7 +24,7 @@ LightSet::LightSet(const Scene& scene, const SurfaceLookup& surfaces) {
       lsk::ShadeLight l{};
       surfaces.world_triangle(i, t, l.a, l.b, l.c);
       l.emission = e;
-      l.area = 0.5f * glm::length(glm::cross(l.b - l.a, l.c - l.a));
+      l.area = lsk::triangle_area_scaled(l.a, l.b, l.c, unit_k, l.normal);
       if (!(l.area > 0.0f) || !std::isfinite(l.area)) continue;
       lights.push_back(l);
       power.push_back(double(l.area) * lsk::luminance(e));
@@ -43,10 +46,16 @@ void average_passes(RenderResult& result, int spp) {
   const float inv_spp = 1.0f / float(std::max(1, spp));
   result.total.assign(pixels, glm::vec3(0.0f));
   for (auto& img : result.bounce_images)
-    for (size_t p = 0; p < pixels; ++p) {
-      img[p] *= inv_spp;
-      result.total[p] += img[p];
-    }
+    for (size_t p = 0; p < pixels; ++p) img[p] *= inv_spp;
+  // The total adds finite bounce images; one whose sum passes the float range keeps the largest
+  // float instead (and is counted with the dropped samples): no image ever holds Inf or NaN.
+  for (size_t p = 0; p < pixels; ++p) {
+    glm::dvec3 sum(0.0);
+    for (const auto& img : result.bounce_images) sum += glm::dvec3(img[p]);
+    const glm::dvec3 clamped = glm::min(sum, glm::dvec3(double(std::numeric_limits<float>::max())));
+    result.total[p] = glm::vec3(clamped);
+    if (clamped != sum) ++result.dropped_samples;
+  }
 }
 
 lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& lights, const RenderOptions& options) {
@@ -57,6 +66,7 @@ lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& l
   c.shade.light_count = uint32_t(lights.lights.size());
   c.shade.total_power = lights.total_power;
   c.shade.bounces = uint32_t(std::max(0, options.bounces));
+  c.shade.unit_k = lights.unit_k;
   return c;
 }
 
@@ -98,7 +108,12 @@ std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const
 
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
                     const Progress& progress, const BatchTracer& tracer) {
-  const BatchTracer trace_batch = tracer ? tracer : BatchTracer(trace_rays);
+  // The first trace_rays overload: each structure's own traversal (accel.traversal).
+  const BatchTracer trace_batch =
+      tracer ? tracer
+             : BatchTracer([](const Accel& a, const lsk::Ray* r, lsk::Hit* h, size_t n, bool any, lsk::LsCounters* c) {
+                 trace_rays(a, r, h, n, any, c);
+               });
   const auto start = std::chrono::steady_clock::now();
   const uint32_t pixels = options.width * options.height;
   const int bounces = options.bounces;
@@ -129,10 +144,12 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   std::vector<uint32_t> dropped(pixels, 0);
 
   for (int s = 0; s < options.spp; ++s) {
+    throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
     const uint32_t sample = uint32_t(s);
     tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) { shading.start_path(p, sample, cam, paths[p]); });
 
     for (int k = 0; k <= bounces; ++k) {
+      throw_if_interrupted();
       const uint32_t bounce = uint32_t(k);
       const Accel& structure = *accel[size_t(k)];
       BounceStats& stats = result.bounces[size_t(k)];

@@ -50,7 +50,8 @@ struct RenderResult {
   std::vector<std::vector<glm::vec3>> bounce_images;  // bounces + 1 images, row-major, top row first
   std::vector<glm::vec3> total;
   std::vector<BounceStats> bounces;
-  uint64_t dropped_samples = 0;                       // non-finite contributions left out
+  uint64_t dropped_samples = 0;  // contributions left out as non-finite (or whose sum would be), and
+                                 // total pixels clamped to the float range: images hold no Inf/NaN
   double seconds = 0.0;                               // whole render, shading included
   uint64_t indirect_rays() const;
   double indirect_seconds() const;
@@ -65,18 +66,21 @@ using BatchTracer = std::function<void(const Accel& accel, const lsk::Ray* rays,
                                        lsk::LsCounters* counters)>;
 
 // Emissive world triangles with a CDF by power (area x luminance of emission), as the shading
-// kernel's arrays (common/kernels/shade_path.h).
+// kernel's arrays (common/kernels/shade_path.h).  Areas, distances and densities are in scene units
+// (kernels/scaled_geometry.h), so they stay finite at 1e20 and 1e-20.
 struct LightSet {
   std::vector<lsk::ShadeLight> lights;
   std::vector<float> cdf;  // inclusive, last == 1
   float total_power = 0.0f;
+  int unit_k = 0;  // areas, distances and densities are in scene units (lengths x 2^unit_k)
   LightSet(const Scene& scene, const SurfaceLookup& surfaces);
 };
 
 // The shading kernel's context for a render: the surfaces' arrays, the lights and the options.
 lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& lights, const RenderOptions& options);
 
-// Turns the bounce images' sums over spp passes into averages and fills the total image.
+// Turns the bounce images' sums over spp passes into averages and fills the total image (clamped to
+// the float range; each clamped pixel counts as a dropped sample).
 void average_passes(RenderResult& result, int spp);
 
 // structures: built structures keyed by canonical name; every schedule entry must be present.

@@ -1,5 +1,7 @@
 #include "ray_files.h"
 
+#include "interrupt.h"
+
 #include "scene.h"
 
 #include <cmath>
@@ -32,6 +34,7 @@ std::vector<T> read_records(const std::string& path, const char* what) {
 
 template <typename T>
 void write_records(const std::string& path, const std::vector<T>& records, const char* what) {
+  throw_if_interrupted();
   const std::string temp = path + ".partial";
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);

@@ -14,7 +14,8 @@ RayKind parse_ray_kind(const std::string& text) {
   if (text == "primary") return RayKind::Primary;
   if (text == "diffuse") return RayKind::Diffuse;
   if (text == "random") return RayKind::Random;
-  throw InputError("unknown ray kind '" + text + "' (expected primary, diffuse or random)");
+  if (text == "shadow") return RayKind::Shadow;
+  throw InputError("unknown ray kind '" + text + "' (expected primary, diffuse, random or shadow)");
 }
 
 namespace {
@@ -30,6 +31,20 @@ lsk::Ray primary_ray(const lsk::CameraFrame& cam, uint32_t seed, uint32_t index)
 }  // namespace
 
 std::vector<lsk::Ray> generate_rays(const Scene& scene, const Accel& exact, RayKind kind, size_t count, uint32_t seed) {
+  if (kind == RayKind::Shadow) {
+    // Segments between the origins of two diffuse rays (surface points, each offset off its surface).
+    std::vector<lsk::Ray> rays = generate_rays(scene, exact, RayKind::Diffuse, count, seed);
+    std::vector<lsk::Ray> segments(count);
+    for (size_t i = 0; i < count; ++i) {
+      size_t j = (i + count / 2) % count;
+      if (rays[j].origin == rays[i].origin) j = (i + 1) % count;
+      segments[i].origin = rays[i].origin;
+      segments[i].tmin = 0.0f;
+      segments[i].dir = rays[j].origin - rays[i].origin;
+      segments[i].tmax = 1.0f;
+    }
+    return segments;
+  }
   std::vector<lsk::Ray> rays(count);
   const lsk::CameraFrame cam = camera_frame(scene.camera, kImageSide, kImageSide);
   if (kind == RayKind::Primary) {

@@ -3,6 +3,8 @@
 //   diffuse  the first diffuse bounce: a primary ray's exact hit, offset, then a cosine-weighted
 //            direction about the geometric normal (the rays the paper's MRays/s are about)
 //   random   origins uniform in the world bounds, directions uniform on the sphere
+//   shadow   segments (tmax = 1) between the origins of two diffuse rays: visibility between surface
+//            points, for any-hit queries
 #pragma once
 
 #include "accel.h"
@@ -13,7 +15,7 @@
 
 namespace ls {
 
-enum class RayKind { Primary, Diffuse, Random };
+enum class RayKind { Primary, Diffuse, Random, Shadow };
 
 RayKind parse_ray_kind(const std::string& text);  // throws InputError
 

@@ -2,6 +2,7 @@
 
 #include "bench.h"
 #include "image_output.h"
+#include "interrupt.h"
 
 #include <tbb/info.h>
 
@@ -74,13 +75,21 @@ nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& 
     write_exr((out / ("bounce_" + std::to_string(k) + ".exr")).string(),
               Image{result.width, result.height, result.bounce_images[k]});
   nlohmann::json report = render_report(result, context);
-  const std::string path = (out / "report.json").string();
+  const std::string path = (out / "report.json").string(), temp = path + ".partial";
+  throw_if_interrupted();
+  set_partial_file(&temp);
   {
-    std::ofstream f(path + ".partial");
+    std::ofstream f(temp);
     f << report.dump(2) << "\n";
-    if (!f) throw InputError("cannot write '" + path + "'");
+    if (!f) {
+      set_partial_file(nullptr);
+      std::error_code ec;
+      std::filesystem::remove(temp, ec);
+      throw InputError("cannot write '" + path + "'");
+    }
   }
-  std::filesystem::rename(path + ".partial", path);
+  std::filesystem::rename(temp, path);
+  set_partial_file(nullptr);
   return report;
 }
 

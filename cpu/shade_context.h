@@ -9,6 +9,7 @@
 #include "kernels/offset_ray.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
+#include "kernels/scaled_geometry.h"
 
 namespace lsk {
 

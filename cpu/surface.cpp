@@ -1,6 +1,7 @@
 #include "surface.h"
 
 #include "kernels/float_bits.h"
+#include "kernels/scaled_geometry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,9 +83,9 @@ SurfacePoint SurfaceLookup::at(const lsk::Hit& hit, const glm::vec3& ray_dir) co
 lsk::CameraFrame camera_frame(const Camera& camera, uint32_t width, uint32_t height) {
   lsk::CameraFrame f;
   f.position = camera.position;
-  glm::vec3 forward = camera.target - camera.position;
-  if (!(glm::length(forward) > 0.0f)) forward = glm::vec3(0.0f, 0.0f, -1.0f);
-  f.forward = glm::normalize(forward);
+  // normalize_any: at 1e20 the length of target - position overflows (kernels/scaled_geometry.h).
+  f.forward = lsk::normalize_any(camera.target - camera.position);
+  if (f.forward == glm::vec3(0.0f)) f.forward = glm::vec3(0.0f, 0.0f, -1.0f);
   glm::vec3 right = glm::cross(f.forward, camera.up);
   if (!(glm::length(right) > 1e-6f)) right = glm::cross(f.forward, std::fabs(f.forward.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0));
   f.right = glm::normalize(right);

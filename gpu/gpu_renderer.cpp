@@ -2,6 +2,7 @@
 
 #include "gpu_line_space.h"
 #include "gpu_trace.h"
+#include "interrupt.h"
 #include "shaders.h"
 
 #include <algorithm>
@@ -30,7 +31,7 @@ struct ShadeConstants {
   lsk::ShadeParams shade;
   lsk::CameraFrame cam;
 };
-static_assert(sizeof(ShadeConstants) == 96, "must match the GLSL buffer Constants");
+static_assert(sizeof(ShadeConstants) == 112, "must match the GLSL buffer Constants");
 
 // A list of rays with the pixel each belongs to, and their hits.
 struct RayList {
@@ -111,6 +112,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
   };
 
   for (int s = 0; s < options.spp; ++s) {
+    throw_if_interrupted();  // between passes and bounces, like the CPU renderer
     ShadePush push;
     push.sample_index = uint32_t(s);
     push.mode = 0;
@@ -118,6 +120,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     run_shade(push, extension, extension);  // writes the camera rays into extension's list
     uint32_t extension_count = pixels;
     for (int k = 0; k <= bounces; ++k) {
+      throw_if_interrupted();
       BounceStats& stats = result.bounces[size_t(k)];
       stats.extension_rays += extension_count;
       if (extension_count == 0) break;

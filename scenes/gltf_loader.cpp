@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -195,7 +196,8 @@ class GltfReader {
     for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
       const tinygltf::Primitive& prim = gm.primitives[pi];
       const std::string where = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi);
-      const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+      // tinygltf writes TRIANGLES for an absent mode (-1 only in a default-constructed primitive).
+      const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
       if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE || mode == TINYGLTF_MODE_LINE_LOOP ||
           mode == TINYGLTF_MODE_LINE_STRIP)
         fail(where + ": non-triangle primitive (points or lines)");
@@ -370,7 +372,10 @@ class GltfReader {
       if (!finite(position) || !forward || !up)
         fail("camera node " + std::to_string(*camera_node) + " has a degenerate transform");
       scene.camera.position = position;
-      scene.camera.target = position + *forward;
+      // One unit ahead vanishes into the rounding of a position 1e30 away: look as far ahead as the
+      // position is from the origin.
+      const float reach = std::max({1.0f, std::fabs(position.x), std::fabs(position.y), std::fabs(position.z)});
+      scene.camera.target = position + *forward * reach;
       scene.camera.up = *up;
       scene.camera.yfov = float(yfov);
       has_camera_ = true;
@@ -388,29 +393,66 @@ class GltfReader {
 
 }  // namespace
 
-Scene load_gltf(const std::string& path) {
+namespace {
+
+// Loads through `load` (which fills model, err and warn), then reads and validates the model.
+template <typename Load>
+Scene load_gltf_with(const std::string& name, Load&& load) {
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(ignore_image, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   bool ok = false;
   try {
-    ok = lower_ext(path) == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                                   : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    ok = load(loader, model, err, warn);
   } catch (const std::bad_alloc&) {
     throw;
   } catch (const std::exception& e) {  // tinygltf 2.7 indexes with .at() on some malformed files
-    throw InputError(path + ": malformed glTF (" + e.what() + ")");
+    throw InputError(name + ": malformed glTF (" + e.what() + ")");
   }
   // Warnings alone (an unreadable texture, say) do not matter: only colour factors are used.
-  if (!ok) throw InputError(path + ": " + first_line(err.empty() ? warn : err));
+  if (!ok) throw InputError(name + ": " + first_line(err.empty() ? warn : err));
 
-  GltfReader reader(model, path);
+  GltfReader reader(model, name);
   Scene scene = reader.read();
-  scene.name = path;
+  scene.name = name;
   validate_scene(scene);
   if (!reader.has_camera()) scene.camera = framing_camera(scene);
   return scene;
+}
+
+// File callbacks for bytes in memory: no file may be opened (a URI would name one relative to a
+// folder the bytes do not have).
+bool no_file_exists(const std::string&, void*) { return false; }
+std::string no_expand(const std::string& path, void*) { return path; }
+bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+  if (err) *err += "external file '" + path + "' cannot be read from bytes in memory\n";
+  return false;
+}
+bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
+
+}  // namespace
+
+Scene load_gltf(const std::string& path) {
+  const bool binary = lower_ext(path) == ".glb";
+  return load_gltf_with(path, [&](tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn) {
+    return binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                  : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  });
+}
+
+Scene load_gltf_bytes(const std::string& bytes, const std::string& name, bool binary) {
+  return load_gltf_with(name, [&](tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn) {
+    tinygltf::FsCallbacks fs{&no_file_exists, &no_expand, &no_read, &no_write, nullptr};
+    loader.SetFsCallbacks(fs);
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    if (bytes.size() > UINT32_MAX) {
+      err = "larger than 4 GiB";
+      return false;
+    }
+    return binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), "")
+                  : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), "");
+  });
 }
 
 }  // namespace ls

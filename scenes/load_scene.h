@@ -17,10 +17,18 @@ Scene load_scene(const std::string& spec);
 // first perspective camera is the view (else a framing camera).
 Scene load_gltf(const std::string& path);
 
+// The same from bytes already in memory (fuzzing, tests): `name` only labels messages.  binary picks
+// .glb over .gltf.  External buffer URIs are refused: there is no folder to resolve them against.
+Scene load_gltf_bytes(const std::string& bytes, const std::string& name, bool binary);
+
 // One OBJ/PLY/OFF/STL mesh, read by strict readers of our own (OpenMesh 9's readers crash or hang on
 // malformed files, and drop non-manifold faces, which would shift triangle ids): a one-object scene with a framing camera and a
 // default light (a white background that lights the mesh from every direction).
 Scene load_mesh_file(const std::string& path);
+
+// The same from bytes in memory; `format` is the extension (".obj", ".off", ".ply" or ".stl") and
+// `name` labels messages.
+Scene load_mesh_bytes(const std::string& bytes, const std::string& format, const std::string& name);
 
 // Built-in, deterministic scenes (no files):
 //   builtin:cornell                  closed room, several objects, one area light (the default scene)

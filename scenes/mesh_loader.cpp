@@ -584,12 +584,19 @@ std::string lower_ext(const std::string& path) {
 
 Scene load_mesh_file(const std::string& path) {
   const Failer fail(path);
-  const std::string ext = lower_ext(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) fail("cannot be opened");
   std::ostringstream buffer;
   buffer << in.rdbuf();
-  const std::string data = std::move(buffer).str();
+  Scene scene = load_mesh_bytes(std::move(buffer).str(), lower_ext(path), path);
+  scene.meshes[0].name = scene.instances[0].name = std::filesystem::path(path).stem().string();
+  return scene;
+}
+
+Scene load_mesh_bytes(const std::string& data, const std::string& format, const std::string& name) {
+  const Failer fail(name);
+  std::string ext = format;
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
 
   Polygons poly;
   if (ext == ".obj") poly = read_obj(data, fail);
@@ -601,14 +608,14 @@ Scene load_mesh_file(const std::string& path) {
   finish_normals(poly);
 
   Mesh mesh;
-  mesh.name = std::filesystem::path(path).stem().string();
+  mesh.name = name;
   mesh.positions = std::move(poly.positions);
   mesh.normals = std::move(poly.normals);
   mesh.triangles = std::move(poly.triangles);
   mesh.materials.assign(mesh.triangles.size(), 0);
 
   Scene scene;
-  scene.name = path;
+  scene.name = name;
   scene.meshes.push_back(std::move(mesh));
   Instance inst;
   inst.name = scene.meshes[0].name;

@@ -9,7 +9,8 @@ packages=(build-essential cmake ninja-build pkg-config
   glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
   mesa-vulkan-drivers libvulkan-dev vulkan-tools
   python3-matplotlib   # linespace-validate sweep plots (validate/plot_tradeoff.py)
-  python3 sweethome3d-furniture libcgal-demo)  # the real scenes: assembler, sources (scenes/README.md)
+  python3 sweethome3d-furniture libcgal-demo  # the real scenes: assembler, sources (scenes/README.md)
+  clang-14 libclang-rt-14-dev)  # clang-14 + its runtimes: the libFuzzer harnesses (scripts/run-sanitizers.sh)
 
 missing=()
 for p in "${packages[@]}"; do

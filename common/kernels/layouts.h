@@ -144,7 +144,8 @@ struct ShadeMaterial {
   uint pad1;
 };
 
-// An emissive world triangle, picked for next-event estimation by the CDF light_cdf[] (by power).
+// An emissive world triangle, picked for next-event estimation by the CDF light_cdf[] (by power);
+// its area is in scene units (kernels/scaled_geometry.h), its normal unit length.
 struct ShadeLight {
   vec3 a;
   float area;
@@ -152,8 +153,10 @@ struct ShadeLight {
   uint pad0;
   vec3 c;
   uint pad1;
-  vec3 emission;
+  vec3 normal;
   uint pad2;
+  vec3 emission;
+  uint pad3;
 };
 
 // Per-render constants of the shading kernel.
@@ -164,6 +167,10 @@ struct ShadeParams {
   uint light_count;
   float total_power;  // sum of area x luminance(emission) over the lights
   uint bounces;       // the last bounce: its light sample takes the full weight, no further segment
+  int unit_k;         // scene units = world lengths x 2^unit_k (kernels/scaled_geometry.h)
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 // One path of the wavefront (one pixel): the segment to trace, the shadow ray of the current bounce

@@ -21,6 +21,7 @@
 #include "offset_ray.h"
 #include "rng.h"
 #include "sampling.h"
+#include "scaled_geometry.h"
 
 // Random dimensions used at each bounce.
 LS_CONST uint LS_DIM_PIXEL_X = 0u;
@@ -49,10 +50,11 @@ LS_FN vec3 instance_normal(IN(ShadeInstance) inst, IN(vec3) n) {
   return r;
 }
 
-// Adds a contribution to a pixel, or counts it as dropped when it is not finite.
+// Adds a contribution to a pixel, or counts it as dropped when the sum is not finite (two huge
+// finite contributions can add up to infinity).
 LS_FN void add_contribution(INOUT(vec3) pixel, INOUT(uint) dropped, IN(vec3) c) {
-  if (finite3(c)) {
-    precise vec3 sum = pixel + c;
+  precise vec3 sum = pixel + c;
+  if (finite3(sum)) {
     pixel = sum;
   } else {
     dropped = dropped + 1u;
@@ -117,14 +119,9 @@ LS_FN void surface_at(IN(Hit) hit, IN(vec3) ray_dir, OUT(vec3) position, OUT(vec
   if (dot_in_order(ng, ray_dir) > 0.0f) ng = -ng;
   precise vec3 nsum = shade_vertices[tri.idx.x].normal * w0 + shade_vertices[tri.idx.y].normal * hit.u +
                       shade_vertices[tri.idx.z].normal * hit.v;
-  vec3 ns = instance_normal(inst, nsum);
-  float ns_len = length_in_order(ns);
-  if (ns_len > 0.0f && !isinf(ns_len) && !isnan(ns_len)) {
-    precise vec3 q = ns / ns_len;
-    ns = q;
-  } else {
-    ns = ng;
-  }
+  vec3 ns = normalize_any(instance_normal(inst, nsum));  // a 1e-20 scale's normal matrix holds 1e20
+  precise float ns_sum = ns.x + ns.y + ns.z;
+  if ((ns.x == 0.0f && ns.y == 0.0f && ns.z == 0.0f) || isinf(ns_sum) || isnan(ns_sum)) ns = ng;
   if (dot_in_order(ns, ng) < 0.0f) ns = -ns;
   geometric_normal = ng;
   shading_normal = ns;
@@ -151,7 +148,7 @@ LS_FN void shade_path(uint p, uint sample_index, uint bounce, IN(Hit) hit, INOUT
   if (luminance(mat.emission) > 0.0f) {
     float weight = 1.0f;
     if (bounce > 0u) {
-      precise float dist = hit.t * length_in_order(path.ray.dir);
+      precise float dist = to_scene_units(hit.t * length_in_order(path.ray.dir), shade.unit_k);
       float cos_l = abs(dot_in_order(n, normalize_in_order(path.ray.dir)));
       precise float light_pdf = cos_l > 0.0f ? light_area_pdf(mat.emission) * dist * dist / cos_l : 0.0f;
       weight = power_heuristic(path.bsdf_pdf, light_pdf);
@@ -164,15 +161,14 @@ LS_FN void shade_path(uint p, uint sample_index, uint bounce, IN(Hit) hit, INOUT
     ShadeLight l = lights[pick_light(random01(shade.seed, p, sample_index, bounce, LS_DIM_LIGHT_PICK))];
     vec3 q = sample_triangle(l.a, l.b, l.c, random01(shade.seed, p, sample_index, bounce, LS_DIM_LIGHT_U),
                              random01(shade.seed, p, sample_index, bounce, LS_DIM_LIGHT_V));
-    precise vec3 eb = l.b - l.a;
-    precise vec3 ec = l.c - l.a;
-    vec3 nl = normalize_in_order(cross_in_order(eb, ec));
+    vec3 nl = l.normal;
     precise vec3 to_origin = origin - q;
     if (dot_in_order(nl, to_origin) < 0.0f) nl = -nl;
     vec3 target = offset_ray_origin(q, nl, shade.scene_scale);
     precise vec3 d = target - origin;
-    float dist2 = dot_in_order(d, d);
-    precise vec3 wi = d / sqrt(dist2);
+    vec3 d_units = to_scene_units(d, shade.unit_k);  // exact: a power of two; keeps dist2 finite
+    float dist2 = dot_in_order(d_units, d_units);
+    precise vec3 wi = d_units / sqrt(dist2);
     float cos_s = dot_in_order(n, wi);
     float cos_l = dot_in_order(nl, -wi);
     if (cos_s > 0.0f && cos_l > 0.0f && dist2 > 0.0f) {

@@ -16,6 +16,40 @@
 
 LS_CONST int LS_STACK_SIZE = 64;  // the builder caps BVH depth below this
 
+// Tests the triangles [first, first + count) of a leaf (the CPU's wide traversal shares it).  Returns
+// true when any_hit is set and a hit was found (the caller stops).
+LS_FN bool trace_leaf(uint first, uint count, IN(TriRay) tri_ray, float tmin, uint instance, bool any_hit,
+                      INOUT(Hit) hit, INOUT(uint) hit_prim) {
+  for (uint i = first; i < first + count; ++i) {
+    Triangle tri = tris[i];
+    float t;
+    float u;
+    float v;
+    if (ray_triangle(tri_ray, tmin, hit.t, vec3(tri.v0), vec3(tri.v1), vec3(tri.v2), t, u, v)) {
+      uint inst = instance == LS_INVALID ? tri_instances[i] : instance;
+      if (offer_hit(t, u, v, inst, tri_ids[i], hit)) {
+        hit_prim = i;
+        if (any_hit) return true;
+      }
+    }
+  }
+  return false;
+}
+
+// The ray carried into an instance's object space; an affine map keeps t unchanged.
+LS_FN void instance_ray(IN(InstanceRecord) rec, IN(vec3) origin, IN(vec3) dir, OUT(vec3) object_origin,
+                        OUT(vec3) object_dir) {
+  // Sums spelled out in one order (dot_in_order): CPU and GPU must carry the ray identically.
+  precise vec3 o = vec3(dot_in_order(vec3(rec.world_to_object0), origin) + rec.world_to_object0.w,
+                        dot_in_order(vec3(rec.world_to_object1), origin) + rec.world_to_object1.w,
+                        dot_in_order(vec3(rec.world_to_object2), origin) + rec.world_to_object2.w);
+  precise vec3 d = vec3(dot_in_order(vec3(rec.world_to_object0), dir),
+                        dot_in_order(vec3(rec.world_to_object1), dir),
+                        dot_in_order(vec3(rec.world_to_object2), dir));
+  object_origin = o;
+  object_dir = d;
+}
+
 // Traverses the BVH rooted at nodes[root] with a ray given in that BVH's space.  instance is the id
 // to report, or LS_INVALID to read it per triangle (flat structures).  With use_ls, a node that
 // carries a Line Space is answered by its lookup, and traversed exactly only when the lookup refuses.
@@ -42,19 +76,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
     if (!descend) {
       // answered by the Line Space: continue with the stack
     } else if (node.count > 0u) {
-      for (uint i = node.first; i < node.first + node.count; ++i) {
-        Triangle tri = tris[i];
-        float t;
-        float u;
-        float v;
-        if (ray_triangle(tri_ray, tmin, hit.t, vec3(tri.v0), vec3(tri.v1), vec3(tri.v2), t, u, v)) {
-          uint inst = instance == LS_INVALID ? tri_instances[i] : instance;
-          if (offer_hit(t, u, v, inst, tri_ids[i], hit)) {
-            hit_prim = i;
-            if (any_hit) return true;
-          }
-        }
-      }
+      if (trace_leaf(node.first, node.count, tri_ray, tmin, instance, any_hit, hit, hit_prim)) return true;
     } else {
       uint left = node.first;
       uint right = node.first + 1u;
@@ -96,7 +118,7 @@ LS_FN Hit trace_flat(IN(Ray) ray, bool any_hit) {
   return finish_hit(hit);
 }
 
-// The ray is carried into each instance's object space; an affine map keeps t unchanged.
+// The ray is carried into each instance's object space (instance_ray).
 LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
   Hit hit = empty_hit(ray);
   uint prim = LS_INVALID;
@@ -112,13 +134,9 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
     if (node.count > 0u) {
       for (uint i = node.first; i < node.first + node.count; ++i) {
         InstanceRecord rec = instances[i];
-        // Sums spelled out in one order (dot_in_order): CPU and GPU must carry the ray identically.
-        precise vec3 o = vec3(dot_in_order(vec3(rec.world_to_object0), ray.origin) + rec.world_to_object0.w,
-                              dot_in_order(vec3(rec.world_to_object1), ray.origin) + rec.world_to_object1.w,
-                              dot_in_order(vec3(rec.world_to_object2), ray.origin) + rec.world_to_object2.w);
-        precise vec3 d = vec3(dot_in_order(vec3(rec.world_to_object0), ray.dir),
-                              dot_in_order(vec3(rec.world_to_object1), ray.dir),
-                              dot_in_order(vec3(rec.world_to_object2), ray.dir));
+        vec3 o;
+        vec3 d;
+        instance_ray(rec, ray.origin, ray.dir, o, d);
         if (trace_bvh(rec.root, o, d, ray.tmin, rec.instance, any_hit, ls_enabled != 0u, hit, prim)) return finish_hit(hit);
       }
     } else {

@@ -9,6 +9,7 @@ layout(local_size_x = 64) in;
 #include "kernels/ray_box.h"
 #include "kernels/ray_triangle.h"
 #include "kernels/offset_ray.h"
+#include "kernels/scaled_geometry.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
 #include "kernels/camera.h"

@@ -1,0 +1,41 @@
+// The fast CPU path: traversal of the wide BVH (wide_bvh.h) with SIMD box tests (xsimd), beside the
+// scalar single-source reference (common/kernels/traverse_bvh.h).  It gives the reference's answers
+// bit for bit: the same box arithmetic lane by lane, the same visiting order, and the very same
+// shared kernels for triangles (trace_leaf), instances (instance_ray) and Line Space lookups
+// (ls_lookup), so hits, t, u, v and the Line Space counters are identical.
+#pragma once
+
+#include "trace_context.h"
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+namespace ls {
+
+struct Accel;
+
+// Which traversal trace_rays uses.
+enum class Traversal { Reference, Fast };
+
+Traversal parse_traversal(const std::string& text);  // "reference" or "fast"; throws InputError
+const char* traversal_name(Traversal t);
+
+class FastTracer {
+ public:
+  virtual ~FastTracer() = default;
+  // Traces rays [0, count) against the buffers of `context` (made by Accel::context() of the Accel
+  // this tracer was made for); Line Space counters are added to context.ls_counters.
+  virtual void trace(lsk::TraceContext& context, const lsk::Ray* rays, lsk::Hit* hits, size_t count,
+                     bool any_hit) const = 0;
+  virtual size_t bytes() const = 0;  // the wide nodes and their index
+  virtual int width() const = 0;     // 4 or 8
+};
+
+// width: 4 (treelets of 2 levels) or 8 (3 levels).  The Accel's arrays must stay where they are.
+std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width);
+
+// The SIMD instruction set the fast path was compiled for, e.g. "sse2 (4 floats)".
+std::string fast_path_isa();
+
+}  // namespace ls

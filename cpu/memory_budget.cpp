@@ -1,0 +1,91 @@
+#include "memory_budget.h"
+
+#include "kernels/layouts.h"
+#include "kernels/line_space.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace ls {
+namespace {
+
+std::string mib(double bytes) { return std::to_string(uint64_t(std::ceil(bytes / double(1 << 20)))) + " MiB"; }
+
+// Per triangle while building: the triangle (48 B), its id and instance (8 B), its box and the
+// builder's order and centroid arrays (~64 B), the flat build's world copy (48 B); per node 32 B, at
+// most 2 nodes per triangle.
+constexpr double kBytesPerTriangle = 48 + 8 + 64 + 48 + 2 * sizeof(lsk::BvhNode);
+// A Line Space adds per triangle its octahedral vertex normals (16 B) and per BVH node its LS index.
+constexpr double kLsBytesPerTriangle = sizeof(glm::uvec4) + 2 * sizeof(uint32_t);
+
+// At most this many LS nodes in a BVH over `triangles` at depth `depth` (double: 2^60 is fine).
+double ls_nodes_at_most(size_t triangles, int depth, uint32_t min_triangles) {
+  return std::min(std::ldexp(1.0, depth), std::floor(double(triangles) / double(std::max<uint32_t>(1, min_triangles))));
+}
+
+}  // namespace
+
+size_t memory_budget(size_t max_memory) { return max_memory ? max_memory : physical_memory_bytes() / 2; }
+
+StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSpec& spec, const LsOptions& ls) {
+  // Triangles each BVH holds: every world triangle (flat), or each used mesh once (two-level).
+  std::vector<size_t> per_bvh;
+  if (spec.two_level()) {
+    std::vector<bool> used(scene.meshes.size(), false);
+    for (const Instance& inst : scene.instances) used[inst.mesh] = true;
+    for (size_t m = 0; m < scene.meshes.size(); ++m)
+      if (used[m]) per_bvh.push_back(scene.meshes[m].triangles.size());
+  } else {
+    per_bvh.push_back(triangle_count(scene));
+  }
+  double bvh = 0.0, nodes = 0.0, triangles = 0.0;
+  for (size_t t : per_bvh) {
+    bvh += double(t) * kBytesPerTriangle;
+    triangles += double(t);
+    if (spec.line_space()) nodes += ls_nodes_at_most(t, spec.depth, ls.min_triangles);
+  }
+  if (spec.two_level()) bvh += double(scene.instances.size()) * (sizeof(lsk::InstanceRecord) + 2 * sizeof(lsk::BvhNode) + 64);
+  const double shaft_bytes = 4.0 * 30.0 * std::pow(double(spec.subdivision), 4.0);
+  const double ls_bytes =
+      spec.line_space() ? nodes * (shaft_bytes + sizeof(lsk::LsNode)) + triangles * kLsBytesPerTriangle : 0.0;
+  // Saturate instead of overflowing size_t (2^60 nodes of 2 GB each are representable in double).
+  const double cap = double(SIZE_MAX / 4);
+  StructureEstimate e;
+  e.bvh_bytes = size_t(std::min(bvh, cap));
+  e.ls_bytes = size_t(std::min(ls_bytes, cap));
+  e.ls_nodes_at_most = size_t(std::min(nodes, cap));
+  return e;
+}
+
+void check_structure_budget(const Scene& scene, const StructureSpec& spec, const LsOptions& ls) {
+  const size_t budget = memory_budget(ls.max_memory);
+  const StructureEstimate e = estimate_structure_bytes(scene, spec, ls);
+  if (e.total() <= budget) return;
+  std::string why = "structure '" + spec.name() + "' would take up to " + mib(double(e.total())) + " (";
+  if (spec.line_space())
+    why += "Line Space " + mib(double(e.ls_bytes)) + ": up to " + std::to_string(e.ls_nodes_at_most) + " LS nodes x " +
+           std::to_string(lsk::ls_shaft_count(uint32_t(spec.subdivision))) + " shafts; ";
+  why += "BVH and triangles " + mib(double(e.bvh_bytes)) + "), over the budget of " + mib(double(budget)) + ": ";
+  why += spec.line_space() ? "lower N or D, raise --ls-min-triangles, or raise --max-memory"
+                           : "use a smaller scene or raise --max-memory";
+  throw InputError(why);
+}
+
+size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces) {
+  // Per pixel: bounce images and the total (12 B each), path state, hit, batch ray and hit, shadow
+  // query, flags and counters (~170 B), the PNG's 3 bytes and one EXR conversion copy (12 B).
+  const double per_pixel = 12.0 * double(bounces + 2) + 170.0 + 3.0 + 12.0;
+  return size_t(double(width) * double(height) * per_pixel);
+}
+
+void check_render_budget(uint32_t width, uint32_t height, int bounces, size_t max_memory) {
+  const size_t budget = memory_budget(max_memory);
+  const size_t estimate = estimate_render_bytes(width, height, bounces);
+  if (estimate <= budget) return;
+  throw InputError("render " + std::to_string(width) + "x" + std::to_string(height) + " with " + std::to_string(bounces) +
+                   " bounces would take about " + mib(double(estimate)) + " of image buffers, over the budget of " +
+                   mib(double(budget)) + ": lower --size or --bounces, or raise --max-memory");
+}
+
+}  // namespace ls

@@ -1,0 +1,41 @@
+// Memory budgets: what a structure or a render will take, estimated from the scene and the
+// parameters alone, and refused (InputError naming the estimate, the budget and the parameter to
+// change) before anything large is allocated.  The budget is --max-memory, by default half of the
+// physical memory.  Estimates are upper bounds, so a refusal never waits for a failed allocation.
+#pragma once
+
+#include "line_space_builder.h"
+#include "scene.h"
+#include "structure_name.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace ls {
+
+// max_memory in bytes, or half of the physical memory when 0.
+size_t memory_budget(size_t max_memory);
+
+// Upper bound of the bytes of a structure: BVH nodes, triangles and ids, the build's temporary
+// arrays, and for F-LS / 2L-LS the Line Space at min(2^D, triangles / min_triangles) LS nodes per
+// BVH (subtrees at one depth are disjoint, so no more nodes can qualify), 4-byte candidates.
+struct StructureEstimate {
+  size_t bvh_bytes = 0;
+  size_t ls_bytes = 0;
+  size_t ls_nodes_at_most = 0;
+  size_t total() const { return bvh_bytes + ls_bytes; }
+};
+StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSpec& spec, const LsOptions& ls);
+
+// Throws InputError when estimate_structure_bytes() exceeds memory_budget(ls.max_memory).
+void check_structure_budget(const Scene& scene, const StructureSpec& spec, const LsOptions& ls);
+
+// Bytes of the render's image and per-pixel buffers: (bounces + 2) images of 12 B per pixel, the
+// wavefront state (~170 B per pixel) and the 8-bit PNG, for width x height pixels.
+size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces);
+
+// Throws InputError when estimate_render_bytes() exceeds memory_budget(max_memory).
+void check_render_budget(uint32_t width, uint32_t height, int bounces, size_t max_memory);
+
+}  // namespace ls

@@ -1,0 +1,74 @@
+#include "wide_bvh.h"
+
+#include <array>
+#include <cstring>
+
+namespace ls {
+namespace {
+
+template <int K>
+struct Collapser {
+  const std::vector<lsk::BvhNode>& nodes;
+  const std::vector<uint32_t>& node_ls;
+  WideTree<K>& tree;
+
+  uint32_t ls_of(uint32_t b) const { return node_ls.empty() ? lsk::LS_INVALID : node_ls[b]; }
+
+  // The treelet rooted at the binary inner node b, and (depth first) the treelets below it.
+  uint32_t collapse(uint32_t b) {
+    const uint32_t index = uint32_t(tree.nodes.size());
+    tree.wide_of[b] = index;
+    WideNode<K> w;
+    std::memset(&w, 0, sizeof(w));
+    w.root_ls = ls_of(b);
+    constexpr int kPositions = 1 << (K + 1);
+    std::array<uint32_t, kPositions> at;
+    at.fill(lsk::LS_INVALID);
+    at[1] = b;
+    std::array<uint32_t, kPositions> below{};  // bottom-level inner nodes, collapsed after this one
+    for (int p = 2; p < kPositions; ++p) {
+      const uint32_t parent = at[size_t(p / 2)];
+      if (parent == lsk::LS_INVALID || nodes[parent].count > 0) continue;
+      const uint32_t c = nodes[parent].first + uint32_t(p & 1);
+      at[size_t(p)] = c;
+      const int lane = p - 2;
+      const lsk::BvhNode& n = nodes[c];
+      for (int a = 0; a < 3; ++a) {
+        w.lo[a][lane] = n.lo[a];
+        w.hi[a][lane] = n.hi[a];
+      }
+      w.count[lane] = n.count;
+      w.first[lane] = n.count > 0 ? n.first : 0u;
+      w.ls[lane] = ls_of(c);
+      if (n.count == 0 && uint32_t(p) >= WideNode<K>::kBottom) below[size_t(p)] = 1;
+    }
+    tree.nodes.push_back(w);
+    for (int p = int(WideNode<K>::kBottom); p < kPositions; ++p)
+      if (below[size_t(p)]) {
+        const uint32_t child = collapse(at[size_t(p)]);
+        tree.nodes[index].first[p - 2] = child;
+      }
+    return index;
+  }
+};
+
+}  // namespace
+
+template <int K>
+WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
+                            const std::vector<uint32_t>& roots) {
+  WideTree<K> tree;
+  tree.wide_of.assign(nodes.size(), lsk::LS_INVALID);
+  Collapser<K> c{nodes, node_ls, tree};
+  for (uint32_t r : roots)
+    if (r != lsk::LS_INVALID && r < nodes.size() && nodes[r].count == 0 && tree.wide_of[r] == lsk::LS_INVALID)
+      c.collapse(r);
+  return tree;
+}
+
+template WideTree<2> build_wide_tree<2>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
+                                        const std::vector<uint32_t>&);
+template WideTree<3> build_wide_tree<3>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
+                                        const std::vector<uint32_t>&);
+
+}  // namespace ls
