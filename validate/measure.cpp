@@ -37,4 +37,16 @@ Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageS
   return m;
 }
 
+nlohmann::json study_json(const std::string& scene, const std::string& device, const ImageSettings& settings,
+                          double reference_mrays_per_s, size_t reference_bytes) {
+  return {{"scene", scene},
+          {"device", device},
+          {"width", settings.width},
+          {"height", settings.height},
+          {"spp", settings.spp},
+          {"bounces", settings.bounces},
+          {"seed", settings.seed},
+          {"reference", {{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s}, {"bytes", reference_bytes}}}};
+}
+
 }  // namespace ls

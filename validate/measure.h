@@ -6,6 +6,8 @@
 #include "path_tracer.h"
 #include "study_renderer.h"
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 #include <vector>
 
@@ -37,5 +39,9 @@ struct Measured {
 Reference render_reference(StudyRenderer& renderer, const ImageSettings& settings);
 Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageSettings& settings,
                  const Reference& reference);
+
+// What every study's JSON opens with: the scene, the device, the image settings and the reference.
+nlohmann::json study_json(const std::string& scene, const std::string& device, const ImageSettings& settings,
+                          double reference_mrays_per_s, size_t reference_bytes);
 
 }  // namespace ls

@@ -94,15 +94,9 @@ nlohmann::json RmseStudy::json() const {
     }
     rows_json.push_back(j);
   }
-  return {{"scene", scene},
-          {"device", device},
-          {"width", settings.width},
-          {"height", settings.height},
-          {"spp", settings.spp},
-          {"bounces", settings.bounces},
-          {"seed", settings.seed},
-          {"reference", {{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s}, {"bytes", reference_bytes}}},
-          {"rows", rows_json}};
+  nlohmann::json j = study_json(scene, device, settings, reference_mrays_per_s, reference_bytes);
+  j["rows"] = rows_json;
+  return j;
 }
 
 RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, const std::vector<StructureSpec>& structures,

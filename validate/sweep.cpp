@@ -105,15 +105,10 @@ nlohmann::json Sweep::json() const {
     }
     pts.push_back(j);
   }
-  return {{"scene", scene},
-          {"device", device},
-          {"width", settings.width},
-          {"height", settings.height},
-          {"spp", settings.spp},
-          {"bounces", settings.bounces},
-          {"start_bounce", start_bounce},
-          {"reference", {{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s}, {"bytes", reference_bytes}}},
-          {"points", pts}};
+  nlohmann::json j = study_json(scene, device, settings, reference_mrays_per_s, reference_bytes);
+  j["start_bounce"] = start_bounce;
+  j["points"] = pts;
+  return j;
 }
 
 Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings,
