@@ -50,7 +50,7 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
               {"spp", context.spp},
               {"bounces", int(result.bounces.size()) - 1},
               {"seed", context.seed},
-              {"device", "cpu: " + cpu_model()},
+              {"device", context.device.empty() ? "cpu: " + cpu_model() : context.device},
               {"threads", tbb::info::default_concurrency()},
               {"seconds", result.seconds},
               {"primary", {{"rays", primary.extension_rays + primary.shadow_rays}, {"seconds", primary.trace_seconds}}},

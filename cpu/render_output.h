@@ -15,6 +15,7 @@ struct RenderReportContext {
   int spp = 0;
   uint32_t seed = 0;
   const std::map<std::string, Accel>* structures = nullptr;
+  std::string device;  // who traced: empty for this CPU ("cpu: MODEL" in the report)
 };
 
 nlohmann::json render_report(const RenderResult& result, const RenderReportContext& context);

@@ -1,234 +1,115 @@
-// linespace-gpu: the Vulkan port's command line, with linespace-cpu's subcommands and flags (DESIGN §9)
-// plus --device NAME|INDEX.  Every figure is printed with the device's name.
-// Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
-#include "accel.h"
-#include "cli_flags.h"
+// linespace-gpu: the Vulkan port's command line, with linespace-cpu's subcommands and flags (DESIGN §9;
+// cpu/cli_program.h) plus --device NAME|INDEX.  Line Space candidates are searched, rays traced and
+// paths shaded on the device; every figure is printed with the device's name.
+#include "cli_program.h"
 #include "cli_report.h"
 #include "gpu_line_space.h"
 #include "gpu_renderer.h"
 #include "gpu_trace.h"
-#include "load_scene.h"
-#include "ray_files.h"
-#include "ray_generators.h"
-#include "render_output.h"
 #include "vk_context.h"
 
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <unistd.h>
 
 namespace {
 
 using namespace ls;
-
-struct GpuBenchEntry {
-  std::string structure;
-  double mrays_per_s = 0.0;  // from the median kernel time (timestamps; wall time where there are none)
-  size_t bytes = 0;
-  double build_seconds = 0.0;
-};
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }
 
+class GpuBackend : public Backend {
+ public:
+  explicit GpuBackend(const std::string& choice) : context_(choice), device_(context_.description()) {}
+
+  std::string device() const override { return device_; }
+  Accel build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) override {
+    return gpu::build_accel_gpu(context_, scene, spec, options);
+  }
+  void print_build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options, bool json) override {
+    gpu::GpuSearchTiming timing;
+    const Accel accel = gpu::build_accel_gpu(context_, scene, spec, options, &timing);
+    ls::print_build(accel, json, device_);
+    if (!json && accel.spec.line_space()) {
+      const double shafts = double(accel.ls_info.ls_nodes * accel.ls_info.shafts_per_ls);
+      std::printf("gpu search     %.3f s wall, %.3f s kernels: %.3g shafts/s (kernels) on %s\n", timing.wall_seconds,
+                  timing.kernel_seconds, timing.kernel_seconds > 0.0 ? shafts / timing.kernel_seconds : 0.0, device_.c_str());
+    }
+  }
+  std::vector<lsk::Hit> trace(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, lsk::LsCounters* counters,
+                              std::string* timing_text) override {
+    gpu::GpuAccel uploaded(context_, accel);
+    gpu::GpuTracer tracer(context_);
+    tracer.set_rays(rays);
+    gpu::GpuTraceTiming timing;
+    std::vector<lsk::Hit> hits = tracer.trace(uploaded, any_hit, counters, &timing);
+    if (timing_text) *timing_text = " in " + std::to_string(timing.kernel_seconds) + " s (kernel)";
+    return hits;
+  }
+  RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
+                      const Progress& progress) override {
+    return gpu::render_gpu(context_, scene, structures, options, progress);
+  }
+  // MRays/s from the median kernel time (timestamps; wall time where the queue has none).
+  void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs, int repeats,
+             const AccelOptions& options, bool any_hit, bool json) override {
+    struct Entry {
+      std::string structure;
+      double mrays_per_s = 0.0;
+      size_t bytes = 0;
+      double build_seconds = 0.0;
+    };
+    gpu::GpuTracer tracer(context_);
+    tracer.set_rays(rays);
+    std::vector<Entry> results;
+    for (const StructureSpec& spec : specs) {
+      const Accel accel = gpu::build_accel_gpu(context_, scene, spec, options);
+      gpu::GpuAccel uploaded(context_, accel);
+      tracer.trace(uploaded, any_hit);  // the first dispatch compiles the pipeline on some drivers
+      std::vector<double> seconds;
+      for (int r = 0; r < repeats; ++r) {
+        gpu::GpuTraceTiming t;
+        tracer.trace(uploaded, any_hit, nullptr, &t);
+        seconds.push_back(t.kernel_seconds > 0.0 ? t.kernel_seconds : t.wall_seconds);
+      }
+      results.push_back({spec.name(), double(rays.size()) / median(seconds) * 1e-6, accel.bytes_total(), accel.build_seconds});
+    }
+    if (json) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const Entry& e : results)
+        list.push_back({{"structure", e.structure}, {"mrays_per_s", e.mrays_per_s}, {"bytes", e.bytes},
+                        {"build_seconds", e.build_seconds}, {"device", device_}});
+      std::cout << nlohmann::json{{"rays", rays.size()}, {"repeats", repeats}, {"any_hit", any_hit}, {"device", device_},
+                                  {"results", list}}
+                       .dump(2)
+                << "\n";
+      return;
+    }
+    std::printf("%zu rays (%s), median of %d runs (kernel time), device %s\n", rays.size(),
+                any_hit ? "any hit" : "closest hit", repeats, device_.c_str());
+    std::printf("%-14s %12s %12s %10s  %s\n", "structure", "MRays/s", "MB", "build s", "device");
+    for (const Entry& e : results)
+      std::printf("%-14s %12.2f %12.2f %10.3f  %s\n", e.structure.c_str(), e.mrays_per_s, double(e.bytes) / 1e6,
+                  e.build_seconds, device_.c_str());
+  }
+
+ private:
+  gpu::VulkanContext context_;
+  std::string device_;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"linespace-gpu: exact and Line Space ray tracing on a Vulkan device"};
-  app.require_subcommand(1);
-  std::string scene_spec = "builtin:cornell";
-  std::string structure = "bvh";
-  std::string device_choice;
-  bool json = false;
-  LsFlags ls_flags;
-  auto add_device = [&](CLI::App* cmd) {
-    cmd->add_option("--device", device_choice, "Vulkan device: index or part of its name (default: discrete GPU first)");
-  };
-
-  auto* build = app.add_subcommand("build", "build a structure (Line Space candidates on the GPU); print sizes and times");
-  ls_flags.add_to(build);
-  add_device(build);
-  build->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
-  build->add_option("--structure", structure, "bvh, 2l-bvh, f-ls:D:N or 2l-ls:D:N")->capture_default_str();
-  build->add_flag("--json", json, "machine-readable output");
-
-  std::string rays_path, hits_path;
-  bool any_hit = false;
-  auto* trace = app.add_subcommand("trace", "trace a ray file on the GPU, write a hit file");
-  ls_flags.add_to(trace);
-  add_device(trace);
-  trace->add_option("--scene", scene_spec)->capture_default_str();
-  trace->add_option("--structure", structure)->capture_default_str();
-  trace->add_option("--rays", rays_path, "ray file (32-byte records)")->required();
-  trace->add_option("--hits", hits_path, "hit file to write (20-byte records)")->required();
-  trace->add_flag("--any-hit", any_hit, "stop at the first hit in [tmin, tmax]");
-
-  std::string kind = "diffuse", out_path;
-  size_t count = 1000000;
-  uint32_t seed = 1;
-  auto* rays = app.add_subcommand("rays", "write a ray file (generated on the host, as linespace-cpu does)");
-  add_device(rays);
-  rays->add_option("--scene", scene_spec)->capture_default_str();
-  rays->add_option("--kind", kind, "primary, diffuse or random")->capture_default_str();
-  rays->add_option("--count", count)->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
-  rays->add_option("--seed", seed)->capture_default_str();
-  rays->add_option("--out", out_path, "ray file to write")->required();
-
-  std::string schedule = "bvh", size_text = "512x512", out_dir = "out/render";
-  int spp = 16, bounces = 3;
-  bool quiet = false;
-  auto* render_cmd = app.add_subcommand("render", "path trace (rays traced on the GPU); write EXRs per bounce, a PNG and report.json");
-  ls_flags.add_to(render_cmd);
-  add_device(render_cmd);
-  render_cmd->add_option("--scene", scene_spec)->capture_default_str();
-  render_cmd->add_option("--schedule", schedule, "structure per bounce, comma-separated, last repeats")->capture_default_str();
-  render_cmd->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 16));
-  render_cmd->add_option("--bounces", bounces, "indirect bounces after the primary hit")->capture_default_str()->check(CLI::Range(0, 64));
-  render_cmd->add_option("--size", size_text, "WIDTHxHEIGHT")->capture_default_str();
-  render_cmd->add_option("--out", out_dir, "output folder")->capture_default_str();
-  render_cmd->add_option("--seed", seed)->capture_default_str();
-  render_cmd->add_flag("--quiet", quiet, "no progress bar");
-
-  std::string structures = "bvh,2l-bvh";
-  int repeats = 5;
-  auto* bench = app.add_subcommand("bench", "MRays/s of each structure on the GPU (kernel time, median)");
-  ls_flags.add_to(bench);
-  add_device(bench);
-  bench->add_option("--scene", scene_spec)->capture_default_str();
-  bench->add_option("--rays", rays_path, "ray file (default: diffuse rays made here)");
-  bench->add_option("--count", count, "diffuse rays to make when --rays is not given")->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
-  bench->add_option("--seed", seed)->capture_default_str();
-  bench->add_option("--structures", structures, "comma-separated structures")->capture_default_str();
-  bench->add_option("--repeat", repeats, "timed runs per structure (median reported)")->capture_default_str()->check(CLI::Range(1, 100));
-  bench->add_flag("--json", json, "machine-readable output");
-
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "linespace-gpu: " << e.what() << " (see --help)\n";
-    return 2;
-  }
-
-  try {
-    const Scene scene = load_scene(scene_spec);
-    if (*rays) {  // host work only: no device needed
-      const RayKind k = parse_ray_kind(kind);
-      const Accel exact = build_accel(scene, parse_structure("bvh"));
-      write_rays(out_path, generate_rays(scene, exact, k, count, seed));
-      std::fprintf(stderr, "wrote %zu %s rays to %s\n", count, kind.c_str(), out_path.c_str());
-      return 0;
-    }
-    const gpu::VulkanContext context(device_choice);
-    const std::string device = context.description();
-    if (*build) {
-      gpu::GpuSearchTiming timing;
-      const Accel accel = gpu::build_accel_gpu(context, scene, parse_structure(structure), ls_flags.options(), &timing);
-      print_build(accel, json, device);
-      if (!json && accel.spec.line_space()) {
-        const double shafts = double(accel.ls_info.ls_nodes * accel.ls_info.shafts_per_ls);
-        std::printf("gpu search     %.3f s wall, %.3f s kernels: %.3g shafts/s (kernels) on %s\n", timing.wall_seconds,
-                    timing.kernel_seconds, timing.kernel_seconds > 0.0 ? shafts / timing.kernel_seconds : 0.0, device.c_str());
-      }
-    } else if (*trace) {
-      const Accel accel = gpu::build_accel_gpu(context, scene, parse_structure(structure), ls_flags.options());
-      const std::vector<lsk::Ray> in = read_rays(rays_path);
-      gpu::GpuAccel uploaded(context, accel);
-      gpu::GpuTracer tracer(context);
-      tracer.set_rays(in);
-      lsk::LsCounters counters{};
-      gpu::GpuTraceTiming timing;
-      const std::vector<lsk::Hit> out = tracer.trace(uploaded, any_hit, &counters, &timing);
-      if (accel.spec.line_space()) print_counters(counters);
-      write_hits(hits_path, out);
-      size_t found = 0;
-      for (const lsk::Hit& h : out) found += h.triangle != lsk::LS_INVALID;
-      std::fprintf(stderr, "traced %zu rays with %s on %s: %zu hits in %.3f s (kernel); wrote %s\n", in.size(),
-                   accel.spec.name().c_str(), device.c_str(), found, timing.kernel_seconds, hits_path.c_str());
-    } else if (*render_cmd) {
-      RenderOptions options;
-      options.schedule = parse_schedule(schedule);
-      const Size size = parse_size(size_text);
-      options.width = size.width;
-      options.height = size.height;
-      options.spp = spp;
-      options.bounces = bounces;
-      options.seed = seed;
-      std::map<std::string, Accel> built = gpu::build_schedule_structures_gpu(context, scene, options.schedule, ls_flags.options());
-      const bool show = !quiet && isatty(2);
-      Progress progress = [&](int done, int total) {
-        if (!show) return;
-        const int width = 30, filled = done * width / total;
-        std::fprintf(stderr, "\rrender [%s%s] %d/%d samples", std::string(size_t(filled), '#').c_str(),
-                     std::string(size_t(width - filled), ' ').c_str(), done, total);
-        if (done == total) std::fprintf(stderr, "\n");
-      };
-      const RenderResult result = gpu::render_gpu(context, scene, built, options, progress);
-      RenderReportContext ctx{scene_spec, options.schedule.name(), spp, seed, &built};
-      nlohmann::json report = write_render_outputs(out_dir, result, ctx);
-      report["device"] = device;
-      std::ofstream(out_dir + "/report.json") << report.dump(2) << "\n";
-      std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", out_dir.c_str(), bounces);
-      std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s on %s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
-                  scene_spec.c_str(), options.width, options.height, spp, bounces, options.schedule.name().c_str(),
-                  device.c_str(), result.seconds, result.indirect_mrays_per_s(), (unsigned long long)result.indirect_rays(),
-                  result.indirect_seconds());
-      if (result.dropped_samples)
-        std::printf("warning: %llu non-finite contributions were left out\n", (unsigned long long)result.dropped_samples);
-    } else if (*bench) {
-      const std::vector<StructureSpec> specs = parse_structure_list(structures);
-      std::vector<lsk::Ray> bench_rays;
-      if (!rays_path.empty()) {
-        bench_rays = read_rays(rays_path);
-      } else {
-        const Accel exact = build_accel(scene, parse_structure("bvh"));
-        bench_rays = generate_rays(scene, exact, RayKind::Diffuse, count, seed);
-      }
-      if (bench_rays.empty()) throw InputError("bench: the ray file holds no rays");
-      gpu::GpuTracer tracer(context);
-      tracer.set_rays(bench_rays);
-      std::vector<GpuBenchEntry> results;
-      for (const StructureSpec& spec : specs) {
-        const Accel accel = gpu::build_accel_gpu(context, scene, spec, ls_flags.options());
-        gpu::GpuAccel uploaded(context, accel);
-        tracer.trace(uploaded, false);  // the first dispatch compiles the pipeline on some drivers
-        std::vector<double> seconds;
-        for (int r = 0; r < repeats; ++r) {
-          gpu::GpuTraceTiming t;
-          tracer.trace(uploaded, false, nullptr, &t);
-          seconds.push_back(t.kernel_seconds > 0.0 ? t.kernel_seconds : t.wall_seconds);
-        }
-        results.push_back({spec.name(), double(bench_rays.size()) / median(seconds) * 1e-6, accel.bytes_total(), accel.build_seconds});
-      }
-      if (json) {
-        nlohmann::json list = nlohmann::json::array();
-        for (const GpuBenchEntry& e : results)
-          list.push_back({{"structure", e.structure}, {"mrays_per_s", e.mrays_per_s}, {"bytes", e.bytes},
-                          {"build_seconds", e.build_seconds}, {"device", device}});
-        std::cout << nlohmann::json{{"rays", bench_rays.size()}, {"repeats", repeats}, {"device", device}, {"results", list}}.dump(2)
-                  << "\n";
-      } else {
-        std::printf("%zu rays, median of %d runs (kernel time), device %s\n", bench_rays.size(), repeats, device.c_str());
-        std::printf("%-14s %12s %12s %10s  %s\n", "structure", "MRays/s", "MB", "build s", "device");
-        for (const GpuBenchEntry& e : results)
-          std::printf("%-14s %12.2f %12.2f %10.3f  %s\n", e.structure.c_str(), e.mrays_per_s, double(e.bytes) / 1e6,
-                      e.build_seconds, device.c_str());
-      }
-    }
-  } catch (const InputError& e) {
-    std::cerr << "linespace-gpu: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "linespace-gpu: error: " << e.what() << "\n";
-    return 2;
-  }
-  return 0;
+  ProgramInfo info;
+  info.name = "linespace-gpu";
+  info.description = "linespace-gpu: exact and Line Space ray tracing on a Vulkan device";
+  info.device_flag = true;
+  info.make_backend = [](const std::string& device) { return std::make_unique<GpuBackend>(device); };
+  return run_program(argc, argv, info);
 }

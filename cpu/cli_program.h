@@ -1,0 +1,46 @@
+// The command line both programs share (DESIGN §9): linespace-cpu and linespace-gpu declare their
+// subcommands and flags here, once, and differ only in their Backend, which says where structures are
+// built, rays traced and images rendered.  Exit status: 0 success, 1 a check failed, 2 bad input or
+// usage (a one-line reason on stderr), 128 + signal when interrupted.
+#pragma once
+
+#include "accel.h"
+#include "path_tracer.h"
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ls {
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  // Who traces: "" for this CPU (reports then say "cpu: MODEL"), else the device's description.
+  virtual std::string device() const = 0;
+  virtual Accel build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) = 0;
+  // `build`: builds and prints the structure (DESIGN §9 keys), with what this backend adds.
+  virtual void print_build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options, bool json) = 0;
+  // `trace`: hits and Line Space counters (added to *counters); `timing` says how long, for the log line.
+  virtual std::vector<lsk::Hit> trace(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit,
+                                      lsk::LsCounters* counters, std::string* timing) = 0;
+  virtual RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures,
+                              const RenderOptions& options, const Progress& progress) = 0;
+  // `bench`: times and prints (text or JSON).
+  virtual void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs,
+                     int repeats, const AccelOptions& options, bool any_hit, bool json) = 0;
+};
+
+struct ProgramInfo {
+  std::string name;            // "linespace-cpu"
+  std::string description;     // the --help banner
+  bool device_flag = false;    // --device NAME|INDEX on every subcommand (the GPU program)
+  // Makes the backend once the command line is parsed, for the subcommands that need one.
+  std::function<std::unique_ptr<Backend>(const std::string& device)> make_backend;
+};
+
+int run_program(int argc, char** argv, const ProgramInfo& info);
+
+}  // namespace ls
