@@ -14,6 +14,15 @@ size_t triangle_count(const Scene& scene) {
   return n;
 }
 
+Bounds transform_bounds(const glm::mat4& m, const Bounds& box) {
+  Bounds out;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) ? box.hi.x : box.lo.x, (corner & 2) ? box.hi.y : box.lo.y, (corner & 4) ? box.hi.z : box.lo.z);
+    out.grow(transform_point(m, p));
+  }
+  return out;
+}
+
 Bounds world_bounds(const Scene& scene) {
   Bounds b;
   for (const Instance& inst : scene.instances)

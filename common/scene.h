@@ -69,6 +69,8 @@ struct Bounds {
 size_t triangle_count(const Scene& scene);       // world triangles, every instance counted
 Bounds world_bounds(const Scene& scene);
 glm::vec3 transform_point(const glm::mat4& m, const glm::vec3& p);
+// The box around the 8 transformed corners of `box` (an affine map's image of the box lies inside it).
+Bounds transform_bounds(const glm::mat4& m, const Bounds& box);
 
 // Throws InputError when the scene cannot be traced correctly: no triangles, indices out of range,
 // NaN/Inf positions or normals, singular or projective transforms, materials out of range, a camera

@@ -33,7 +33,8 @@ std::string StructureSpec::name() const {
     case StructureKind::FlatBvh: return "bvh";
     case StructureKind::TwoLevelBvh: return "2l-bvh";
     case StructureKind::FlatLs: return "f-ls:" + std::to_string(depth) + ":" + std::to_string(subdivision);
-    case StructureKind::TwoLevelLs: return "2l-ls:" + std::to_string(depth) + ":" + std::to_string(subdivision);
+    case StructureKind::TwoLevelLs:
+      return budgeted ? "2l-ls:auto" : "2l-ls:" + std::to_string(depth) + ":" + std::to_string(subdivision);
   }
   return "?";
 }
@@ -44,6 +45,11 @@ StructureSpec parse_structure(const std::string& raw) {
   if (text == "bvh" || text == "f-bvh") return spec;
   if (text == "2l-bvh") {
     spec.kind = StructureKind::TwoLevelBvh;
+    return spec;
+  }
+  if (text == "2l-ls:auto") {
+    spec.kind = StructureKind::TwoLevelLs;
+    spec.budgeted = true;
     return spec;
   }
   std::string prefix, d, n;
@@ -63,7 +69,7 @@ StructureSpec parse_structure(const std::string& raw) {
     break;
   }
   if (prefix.empty())
-    throw InputError("unknown structure '" + raw + "' (expected bvh, f-bvh, 2l-bvh, f-ls:D:N or 2l-ls:D:N)");
+    throw InputError("unknown structure '" + raw + "' (expected bvh, f-bvh, 2l-bvh, f-ls:D:N, 2l-ls:D:N or 2l-ls:auto)");
   spec.kind = prefix == "f-ls" ? StructureKind::FlatLs : StructureKind::TwoLevelLs;
   spec.depth = parse_int(d, "depth D", 0, kMaxLsDepth, raw);
   spec.subdivision = parse_int(n, "subdivision N", 1, kMaxLsSubdivision, raw);

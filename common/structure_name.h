@@ -1,5 +1,6 @@
 // Names of the acceleration structures and per-bounce schedules (DESIGN §9):
 //   bvh (alias f-bvh), 2l-bvh, f-ls:D:N, 2l-ls:D:N   (f-ls(D,N) and 2l-ls(D,N) accepted too)
+//   2l-ls:auto: a two-level Line Space whose D and N are chosen per object under --ls-budget MB
 //   schedule: comma-separated structures, one per bounce from bounce 0, the last repeating.
 #pragma once
 
@@ -14,6 +15,7 @@ struct StructureSpec {
   StructureKind kind = StructureKind::FlatBvh;
   int depth = 0;        // LS integration depth D (LS kinds only)
   int subdivision = 0;  // LS patches per face edge N (LS kinds only)
+  bool budgeted = false;  // 2l-ls:auto: D and N per object, from the Line Space budget (depth, subdivision 0)
 
   bool two_level() const { return kind == StructureKind::TwoLevelBvh || kind == StructureKind::TwoLevelLs; }
   bool line_space() const { return kind == StructureKind::FlatLs || kind == StructureKind::TwoLevelLs; }

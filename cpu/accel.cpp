@@ -1,5 +1,6 @@
 #include "accel.h"
 
+#include "ls_budget.h"
 #include "memory_budget.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -25,15 +26,6 @@ lsk::Triangle make_triangle(const glm::vec3& a, const glm::vec3& b, const glm::v
   t.v1 = glm::vec4(b, 0.0f);
   t.v2 = glm::vec4(c, 0.0f);
   return t;
-}
-
-Bounds transformed_bounds(const glm::mat4& m, const glm::vec3& lo, const glm::vec3& hi) {
-  Bounds box;
-  for (int corner = 0; corner < 8; ++corner) {
-    const glm::vec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
-    box.grow(transform_point(m, p));
-  }
-  return box;
 }
 
 // Which meshes some instance uses: the structures hold only those.
@@ -121,7 +113,7 @@ void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& 
   std::vector<Bounds> boxes;
   for (const Instance& inst : scene.instances) {
     const lsk::BvhNode& root = accel.nodes[accel.object_roots[inst.mesh]];
-    boxes.push_back(transformed_bounds(inst.object_to_world, root.lo, root.hi));
+    boxes.push_back(transform_bounds(inst.object_to_world, Bounds{root.lo, root.hi}));
   }
   BvhBuildResult top = build_bvh(boxes, options);
   accel.top_nodes = std::move(top.nodes);
@@ -163,13 +155,12 @@ lsk::TraceContext Accel::context() const {
   c.tri_instances = tri_instances.data();
   c.top_nodes = top_nodes.data();
   c.instances = instances.data();
-  if (spec.line_space()) {
+  if (spec.line_space() && !node_ls.empty()) {  // laid out (a 2l-ls:auto plan traces before it has one)
     c.node_ls = node_ls.data();
     c.ls_nodes = ls_nodes.data();
     c.ls_candidates = ls_candidates.data();
     c.tri_normals = tri_normals.data();
     c.ls_enabled = 1;
-    c.ls_n = uint32_t(spec.subdivision);
     const double a = double(ls_options.angle_degrees) * 3.14159265358979323846 / 180.0;
     c.ls_cos2 = ls_options.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
   }
@@ -178,6 +169,8 @@ lsk::TraceContext Accel::context() const {
 
 Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) {
   // Refuse from the scene and parameters alone, before any large allocation (memory_budget.h).
+  if (spec.budgeted && options.ls.objects.empty() && options.ls.budget == 0)
+    throw InputError("structure '2l-ls:auto' needs a Line Space budget: --ls-budget MB");
   check_structure_budget(scene, spec, options.ls);
   const auto start = std::chrono::steady_clock::now();
   Accel accel;
@@ -189,8 +182,13 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
   else
     build_flat(scene, options.bvh, accel);
   if (spec.line_space()) {
-    if (options.search_candidates) build_line_space(scene, options.ls, accel);
-    else layout_line_space(scene, options.ls, accel);
+    LsOptions ls = options.ls;
+    if (spec.budgeted && ls.objects.empty()) {  // 2l-ls:auto: D and N per object, measured (ls_budget.h)
+      accel.ls_plan = std::make_shared<const LsPlan>(plan_line_space_budget(scene, accel, ls));
+      ls.objects = accel.ls_plan->objects(scene.meshes.size());
+    }
+    if (options.search_candidates) build_line_space(scene, ls, accel);
+    else layout_line_space(scene, ls, accel);
   }
   const auto wide_start = std::chrono::steady_clock::now();
   accel.fast = make_fast_tracer(accel, options.wide_width);

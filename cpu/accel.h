@@ -6,6 +6,7 @@
 #include "bvh_builder.h"
 #include "fast_tracer.h"
 #include "line_space_builder.h"
+#include "ls_budget.h"
 #include "scene.h"
 #include "structure_name.h"
 #include "trace_context.h"
@@ -39,6 +40,7 @@ struct Accel {
   std::vector<glm::uvec4> tri_normals;      // octahedral vertex normals per triangle (BVH order)
   LsOptions ls_options;
   LsBuildInfo ls_info;
+  std::shared_ptr<const LsPlan> ls_plan;    // 2l-ls:auto: the per-object choice (ls_budget.h)
 
   // The fast CPU path (fast_tracer.h): the wide BVH over the arrays above, and which path trace_rays
   // takes by default.  Both give the same answers; the reference is the GPU's twin.

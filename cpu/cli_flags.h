@@ -43,6 +43,8 @@ struct LsFlags {
   uint32_t min_triangles = LsOptions{}.min_triangles;
   std::string candidates = "compact";
   double max_memory_mb = 0.0;
+  double ls_budget_mb = 0.0;
+  size_t ls_budget_rays = LsOptions{}.budget_rays;
   bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
   std::string traversal = "fast";
   int wide_width = AccelOptions{}.wide_width;
@@ -62,6 +64,10 @@ struct LsFlags {
         ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
     app->add_option("--max-memory", max_memory_mb, "refuse a structure or render estimated above this many MB (0: half of RAM)")
         ->check(CLI::Range(0.0, 1e9));
+    app->add_option("--ls-budget", ls_budget_mb, "2l-ls:auto: MB of Line Space (bytes_ls) to spend, D and N chosen per object")
+        ->check(CLI::Range(0.0, 1e9));
+    app->add_option("--ls-budget-rays", ls_budget_rays, "2l-ls:auto: pilot diffuse rays that measure each object's error")
+        ->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 24));
   }
   AccelOptions options() const {
     AccelOptions o;
@@ -70,6 +76,8 @@ struct LsFlags {
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
     o.ls.max_memory = size_t(max_memory_mb * 1e6);
+    o.ls.budget = size_t(ls_budget_mb * 1e6);
+    o.ls.budget_rays = ls_budget_rays;
     o.traversal = parse_traversal(traversal);
     o.wide_width = wide_width;
     if (progress)

@@ -141,7 +141,18 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
     std::printf("warning: %llu non-finite contributions were left out\n", (unsigned long long)result.dropped_samples);
 }
 
+// --ls-budget belongs to 2l-ls:auto: given without one it would silently do nothing.
+void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v) {
+  if (v.ls.ls_budget_mb <= 0.0) return;
+  for (const StructureSpec& s : specs)
+    if (s.budgeted) return;
+  throw InputError("--ls-budget applies to 2l-ls:auto only, and no structure here is 2l-ls:auto");
+}
+
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {
+  if (*c.build || *c.trace) check_budget_flag({parse_structure(v.structure)}, v);
+  if (*c.render) check_budget_flag(parse_schedule(v.schedule).per_bounce, v);
+  if (*c.bench) check_budget_flag(parse_structure_list(v.structures), v);
   const Scene scene = load_scene(v.scene);
   if (*c.rays) {  // host work only: no backend (no device) needed
     write_rays(v.out_path, make_rays(scene, v.kind, v.count, v.seed));

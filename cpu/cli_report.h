@@ -4,6 +4,8 @@
 
 #include "accel.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <string>
 
@@ -11,6 +13,10 @@ namespace ls {
 
 // Prints what `build` reports (DESIGN §9 keys); `device`, when given, names who built the candidates.
 void print_build(const Accel& a, bool json, const std::string& device = "");
+
+// A 2l-ls:auto plan (ls_budget.h): as JSON (the `ls_plan` key of build --json), and as a table.
+nlohmann::json ls_plan_json(const LsPlan& plan);
+void print_ls_plan(const LsPlan& plan);
 
 // Line Space lookup counters, one line on stderr.
 void print_counters(const lsk::LsCounters& c);

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <set>
 
 namespace ls {
 namespace {
@@ -55,20 +56,19 @@ glm::uvec4 encode_normals(const glm::vec3& a, const glm::vec3& b, const glm::vec
   return glm::uvec4(enc(a), enc(b), enc(c), 0u);
 }
 
-struct Range {
-  uint32_t first = 0, count = 0;
-};
-
 // Octahedral vertex normals per triangle of the structure, in the space of its BVH: world space for
-// F-LS (each instance's normal matrix applied), object space for 2L-LS.
-void compute_triangle_normals(const Scene& scene, const std::vector<Range>& range, Accel& accel) {
-  accel.tri_normals.resize(accel.tris.size());
+// F-LS (each instance's normal matrix applied), object space for 2L-LS, where only objects that get a
+// Line Space need them (the lookup reads the normals of candidates only).
+}  // namespace
+
+void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees, const LsOptions& options, Accel& accel) {
+  accel.tri_normals.assign(accel.tris.size(), glm::uvec4(0u));
   if (accel.spec.two_level()) {
     for (size_t m = 0; m < accel.object_roots.size(); ++m) {
-      if (accel.object_roots[m] == lsk::LS_INVALID) continue;
+      if (accel.object_roots[m] == lsk::LS_INVALID || object_line_space(accel, options, m).n <= 0) continue;
       const Mesh& mesh = scene.meshes[m];
-      const Range r = range[accel.object_roots[m]];
-      tbb::parallel_for(r.first, r.first + r.count, [&](uint32_t k) {
+      const uint32_t root = accel.object_roots[m];
+      tbb::parallel_for(subtrees.first[root], subtrees.first[root] + subtrees.count[root], [&](uint32_t k) {
         const glm::uvec3 idx = mesh.triangles[accel.tri_ids[k]];
         accel.tri_normals[k] = encode_normals(mesh.normals[idx.x], mesh.normals[idx.y], mesh.normals[idx.z]);
       });
@@ -87,7 +87,6 @@ void compute_triangle_normals(const Scene& scene, const std::vector<Range>& rang
   });
 }
 
-}  // namespace
 
 size_t physical_memory_bytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
@@ -99,116 +98,193 @@ size_t estimate_line_space_bytes(size_t ls_nodes, int n) {
   return size_t(double(ls_nodes) * (shafts * 4.0 + double(sizeof(lsk::LsNode))));
 }
 
-void layout_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
-  const int depth = accel.spec.depth;
-  const uint32_t n = uint32_t(accel.spec.subdivision);
-  const uint32_t shafts = lsk::ls_shaft_count(n);
-  accel.ls_options = options;
-
-  // Subtree ranges and depths: children always follow their parent in the node array.
+BvhSubtrees bvh_subtrees(const Accel& accel) {
+  // Children always follow their parent in the node array: ranges bottom-up, depths top-down.
   const size_t node_count = accel.nodes.size();
-  std::vector<Range> range(node_count);
-  std::vector<int> node_depth(node_count, -1);
+  BvhSubtrees t;
+  t.first.resize(node_count);
+  t.count.resize(node_count);
+  t.depth.assign(node_count, -1);
   for (size_t i = node_count; i-- > 0;) {
     const lsk::BvhNode& node = accel.nodes[i];
-    if (node.count > 0) range[i] = Range{node.first, node.count};
-    else range[i] = Range{range[node.first].first, range[node.first].count + range[node.first + 1].count};
+    if (node.count > 0) {
+      t.first[i] = node.first;
+      t.count[i] = node.count;
+    } else {
+      t.first[i] = t.first[node.first];
+      t.count[i] = t.count[node.first] + t.count[node.first + 1];
+    }
   }
-  std::vector<uint32_t> roots;
-  if (accel.spec.two_level()) {
-    for (uint32_t r : accel.object_roots)
-      if (r != lsk::LS_INVALID) roots.push_back(r);
-  } else {
-    roots.push_back(0);
-  }
-  for (uint32_t r : roots) node_depth[r] = 0;
+  for (uint32_t r : ls_roots(accel)) t.depth[r] = 0;
   for (size_t i = 0; i < node_count; ++i) {
     const lsk::BvhNode& node = accel.nodes[i];
-    if (node.count == 0 && node_depth[i] >= 0) node_depth[node.first] = node_depth[node.first + 1] = node_depth[i] + 1;
+    if (node.count == 0 && t.depth[i] >= 0) t.depth[node.first] = t.depth[node.first + 1] = t.depth[i] + 1;
   }
+  return t;
+}
 
-  // The LS nodes: depth D, enough triangles, a usable box.
-  std::vector<uint32_t> chosen;
-  for (size_t i = 0; i < node_count; ++i)
-    if (node_depth[i] == depth && range[i].count >= std::max<uint32_t>(1, options.min_triangles)) chosen.push_back(uint32_t(i));
+std::vector<uint32_t> ls_roots(const Accel& accel) {
+  if (!accel.spec.two_level()) return {0u};
+  std::vector<uint32_t> roots;
+  for (uint32_t r : accel.object_roots)
+    if (r != lsk::LS_INVALID) roots.push_back(r);
+  return roots;
+}
 
-  const size_t budget = options.max_memory ? options.max_memory : physical_memory_bytes() / 2;
-  const size_t estimate = estimate_line_space_bytes(chosen.size(), int(n));
-  if (estimate > budget)
-    throw InputError("structure '" + accel.spec.name() + "': its Line Space would take about " +
-                     std::to_string(estimate >> 20) + " MiB (" + std::to_string(chosen.size()) + " LS nodes x " +
-                     std::to_string(shafts) + " shafts), over the budget of " + std::to_string(budget >> 20) +
-                     " MiB: lower N or D, or raise --max-memory");
-
-  accel.node_ls.assign(node_count, lsk::LS_INVALID);
-  uint32_t words = 0;
-  for (uint32_t node : chosen) {
-    lsk::LsNode ls{};
+std::vector<LsPlacement> place_line_spaces(const Accel& accel, const BvhSubtrees& subtrees, uint32_t root, int depth, int n,
+                                           const LsOptions& options) {
+  std::vector<LsPlacement> placed;
+  if (n <= 0 || accel.nodes.empty()) return placed;
+  const uint32_t shafts = lsk::ls_shaft_count(uint32_t(n));
+  const uint32_t min_triangles = std::max<uint32_t>(1, options.min_triangles);
+  // The nodes at `depth` below `root`, in node order (a stack walk that stops at that depth).
+  std::vector<uint32_t> stack{root}, found;
+  while (!stack.empty()) {
+    const uint32_t i = stack.back();
+    stack.pop_back();
+    if (subtrees.depth[i] == depth) {
+      if (subtrees.count[i] >= min_triangles) found.push_back(i);
+      continue;
+    }
+    const lsk::BvhNode& node = accel.nodes[i];
+    if (node.count == 0) {
+      stack.push_back(node.first + 1);
+      stack.push_back(node.first);
+    }
+  }
+  std::sort(found.begin(), found.end());
+  for (uint32_t node : found) {
+    LsPlacement p;
+    lsk::LsNode& ls = p.ls;
+    ls = lsk::LsNode{};
     if (!ls_box(accel.nodes[node], ls.lo, ls.hi)) continue;
     ls.scale = float(n) / (ls.hi - ls.lo);
-    ls.range_first = range[node].first;
-    ls.range_count = range[node].count;
+    ls.range_first = subtrees.first[node];
+    ls.range_count = subtrees.count[node];
     ls.bytes = candidate_bytes(ls.range_count, options.paper_candidates);
     ls.node = node;
-    ls.candidates = words;
-    words += uint32_t((uint64_t(shafts) * ls.bytes + 3) / 4);
-    accel.node_ls[node] = uint32_t(accel.ls_nodes.size());
-    accel.ls_nodes.push_back(ls);
+    ls.n = uint32_t(n);
+    ls.inv_n = 1.0f / float(n);
+    p.words = uint32_t((uint64_t(shafts) * ls.bytes + 3) / 4);
+    placed.push_back(p);
   }
-  accel.ls_candidates.assign(words, 0xFFFFFFFFu);  // all ones: every shaft empty until found
-  compute_triangle_normals(scene, range, accel);
+  return placed;
+}
 
+size_t placement_bytes(const std::vector<LsPlacement>& placed) {
+  size_t bytes = 0;
+  for (const LsPlacement& p : placed) bytes += sizeof(lsk::LsNode) + size_t(p.words) * 4;
+  return bytes;
+}
+
+size_t line_space_fixed_bytes(const Accel& accel) {
+  return accel.nodes.size() * sizeof(uint32_t) + accel.tris.size() * sizeof(glm::uvec4);
+}
+
+ObjectLs object_line_space(const Accel& accel, const LsOptions& options, size_t mesh) {
+  if (!options.objects.empty()) return mesh < options.objects.size() ? options.objects[mesh] : ObjectLs{};
+  return ObjectLs{accel.spec.depth, accel.spec.subdivision};
+}
+
+void layout_line_space_nodes(const LsOptions& options, const BvhSubtrees& subtrees, Accel& accel) {
+  accel.ls_options = options;
+  // Every BVH's LS nodes, roots in node order: an object's own D and N (2L), or the structure's.
+  std::vector<LsPlacement> placed;
+  double estimate = 0.0;
+  if (accel.spec.two_level()) {
+    for (size_t m = 0; m < accel.object_roots.size(); ++m) {
+      if (accel.object_roots[m] == lsk::LS_INVALID) continue;
+      const ObjectLs o = object_line_space(accel, options, m);
+      std::vector<LsPlacement> p = place_line_spaces(accel, subtrees, accel.object_roots[m], o.depth, o.n, options);
+      estimate += double(estimate_line_space_bytes(p.size(), o.n));
+      placed.insert(placed.end(), p.begin(), p.end());
+    }
+    std::sort(placed.begin(), placed.end(), [](const LsPlacement& a, const LsPlacement& b) { return a.ls.node < b.ls.node; });
+  } else {
+    placed = place_line_spaces(accel, subtrees, 0u, accel.spec.depth, accel.spec.subdivision, options);
+    estimate = double(estimate_line_space_bytes(placed.size(), accel.spec.subdivision));
+  }
+
+  const size_t budget = options.max_memory ? options.max_memory : physical_memory_bytes() / 2;
+  if (estimate > double(budget)) {
+    const std::string shape = accel.spec.line_space() && accel.spec.subdivision > 0 && options.objects.empty()
+                                  ? std::to_string(placed.size()) + " LS nodes x " +
+                                        std::to_string(lsk::ls_shaft_count(uint32_t(accel.spec.subdivision))) + " shafts"
+                                  : std::to_string(placed.size()) + " LS nodes";
+    throw InputError("structure '" + accel.spec.name() + "': its Line Space would take about " +
+                     std::to_string(size_t(estimate) >> 20) + " MiB (" + shape + "), over the budget of " +
+                     std::to_string(budget >> 20) + " MiB: lower N or D, or raise --max-memory");
+  }
+
+  accel.node_ls.assign(accel.nodes.size(), lsk::LS_INVALID);
+  accel.ls_nodes.clear();
+  uint32_t words = 0;
   LsBuildInfo& info = accel.ls_info;
   info = LsBuildInfo{};
+  std::set<uint32_t> subdivisions;
+  for (LsPlacement& p : placed) {
+    p.ls.candidates = words;
+    words += p.words;
+    accel.node_ls[p.ls.node] = uint32_t(accel.ls_nodes.size());
+    accel.ls_nodes.push_back(p.ls);
+    const size_t shafts = lsk::ls_shaft_count(p.ls.n);
+    info.shafts += shafts;
+    info.candidate_bytes_paper += shafts * 4;
+    info.candidate_bytes_compact += (uint64_t(shafts) * candidate_bytes(p.ls.range_count, false) + 3) / 4 * 4;
+    subdivisions.insert(p.ls.n);
+  }
+  accel.ls_candidates.assign(words, 0xFFFFFFFFu);  // all ones: every shaft empty until found
   info.ls_nodes = accel.ls_nodes.size();
-  info.shafts_per_ls = shafts;
-  info.empty_shafts = info.ls_nodes * size_t(shafts);
+  info.shafts_per_ls = subdivisions.size() == 1 ? lsk::ls_shaft_count(*subdivisions.begin())
+                       : subdivisions.empty() && accel.spec.subdivision > 0 ? lsk::ls_shaft_count(uint32_t(accel.spec.subdivision))
+                                                                            : 0;
+  info.empty_shafts = info.shafts;
   info.candidate_bytes = size_t(words) * 4;
-  info.candidate_bytes_paper = info.ls_nodes * size_t(shafts) * 4;
-  info.candidate_bytes_compact = 0;
-  for (const lsk::LsNode& ls : accel.ls_nodes)
-    info.candidate_bytes_compact += (uint64_t(shafts) * candidate_bytes(ls.range_count, false) + 3) / 4 * 4;
+}
+
+void layout_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
+  const BvhSubtrees subtrees = bvh_subtrees(accel);
+  layout_line_space_nodes(options, subtrees, accel);
+  compute_line_space_normals(scene, subtrees, options, accel);
+}
+
+void store_ls_candidate(Accel& accel, size_t ls_index, uint32_t shaft, uint32_t prim) {
+  const lsk::LsNode& ls = accel.ls_nodes[ls_index];
+  const uint32_t bits = ls.bytes * 8, per_word = 4 / ls.bytes;
+  const uint32_t mask = bits == 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
+  const uint32_t v = prim == lsk::LS_INVALID ? mask : prim - ls.range_first;  // local to the node's triangle range
+  uint32_t& w = accel.ls_candidates[ls.candidates + shaft / per_word];
+  const uint32_t shift = (shaft % per_word) * bits;
+  w = (w & ~(mask << shift)) | ((v & mask) << shift);
 }
 
 size_t pack_ls_candidates(Accel& accel, size_t ls_index, const uint32_t* prims) {
-  const lsk::LsNode& ls = accel.ls_nodes[ls_index];
-  const uint32_t shafts = uint32_t(accel.ls_info.shafts_per_ls);
+  const uint32_t shafts = lsk::ls_shaft_count(accel.ls_nodes[ls_index].n);
   size_t empty = 0;
-  uint32_t* out = accel.ls_candidates.data() + ls.candidates;
-  const uint32_t bits = ls.bytes * 8, per_word = 4 / ls.bytes;
-  const uint32_t mask = bits == 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
   for (uint32_t s = 0; s < shafts; ++s) {
-    const bool none = prims[s] == lsk::LS_INVALID;
-    const uint32_t v = none ? mask : prims[s] - ls.range_first;  // local to the node's triangle range
-    empty += none;
-    uint32_t& w = out[s / per_word];
-    const uint32_t shift = (s % per_word) * bits;
-    w = (w & ~(mask << shift)) | ((v & mask) << shift);
+    store_ls_candidate(accel, ls_index, s, prims[s]);
+    empty += prims[s] == lsk::LS_INVALID;
   }
   return empty;
 }
 
-void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
+void search_line_space(const LsOptions& options, Accel& accel) {
   const auto start = std::chrono::steady_clock::now();
-  layout_line_space(scene, options, accel);
-  const uint32_t n = uint32_t(accel.spec.subdivision);
-  const uint32_t shafts = uint32_t(accel.ls_info.shafts_per_ls);
-
   // The candidate search, every shaft of every LS node, in parallel.
   lsk::TraceContext context = accel.context();
   context.ls_enabled = 0;
-  const float inv_n = 1.0f / float(n);
   const uint32_t instance = ls_search_instance(accel);
   std::atomic<size_t> empty{0}, nodes_done{0};
   std::mutex progress_mutex;
   tbb::parallel_for(size_t(0), accel.ls_nodes.size(), [&](size_t li) {
     const lsk::LsNode ls = accel.ls_nodes[li];
+    const uint32_t shafts = lsk::ls_shaft_count(ls.n);
     std::vector<uint32_t> prims(shafts);
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
       throw_if_interrupted();  // TBB cancels the other blocks and rethrows in the caller
       lsk::TraceContext c = context;
       for (uint32_t s = r.begin(); s != r.end(); ++s)
-        prims[s] = c.ls_find_candidate(ls.node, ls, s, n, inv_n, uint32_t(options.further_rays), instance);
+        prims[s] = c.ls_find_candidate(ls.node, ls, s, uint32_t(options.further_rays), instance);
     });
     empty += pack_ls_candidates(accel, li, prims.data());  // nodes own disjoint words
     const size_t done = ++nodes_done;
@@ -217,8 +293,14 @@ void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel
       progress_mutex.unlock();
     }
   });
-
   accel.ls_info.empty_shafts = empty.load();
+  accel.ls_info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
+  const auto start = std::chrono::steady_clock::now();
+  layout_line_space(scene, options, accel);
+  search_line_space(options, accel);
   accel.ls_info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -16,6 +16,14 @@ namespace ls {
 
 struct Accel;
 
+// The Line Space of one object of a two-level structure: integration depth D and subdivision N
+// (n = 0: no Line Space; the object is traced exactly).
+struct ObjectLs {
+  int depth = 0;
+  int n = 0;
+  bool operator==(const ObjectLs&) const = default;
+};
+
 struct LsOptions {
   // Defaults chosen by measurement: see README, "Line Space parameters".
   int further_rays = 0;          // search rays after the midpoint ray
@@ -23,13 +31,20 @@ struct LsOptions {
   uint32_t min_triangles = 8;    // subtrees with fewer triangles get no LS (0: the paper's behaviour)
   bool paper_candidates = false; // 4-byte candidates instead of the compact 1/2/4-byte local index
   size_t max_memory = 0;         // refuse above this estimate (0: half of physical memory)
+  // Per mesh (2L only): each object's own D and N, overriding the structure's; empty: the
+  // structure's D and N for every object.  2l-ls:auto fills it from the budget (ls_budget.h).
+  std::vector<ObjectLs> objects;
+  // 2l-ls:auto (ls_budget.h): bytes of Line Space to spend (bytes_ls), and the pilot's rays.
+  size_t budget = 0;
+  size_t budget_rays = 1u << 15;
   // Called now and then from the building threads with (LS nodes done, LS nodes): a progress bar.
   std::function<void(size_t done, size_t total)> progress;
 };
 
 struct LsBuildInfo {
   size_t ls_nodes = 0;
-  size_t shafts_per_ls = 0;
+  size_t shafts_per_ls = 0;          // 30 N^4 when every LS node has the same N, else 0
+  size_t shafts = 0;                 // over all LS nodes
   size_t empty_shafts = 0;
   size_t candidate_bytes = 0;        // as stored
   size_t candidate_bytes_paper = 0;  // at 4 bytes per shaft
@@ -47,10 +62,43 @@ void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel
 // normals and fills accel.ls_info (sizes; empty_shafts = every shaft until a search packs its result).
 void layout_line_space(const Scene& scene, const LsOptions& options, Accel& accel);
 
+// The pieces of layout_line_space(), for callers that lay out many Line Spaces over one BVH (the
+// budget's pilot, ls_budget.h).  Per BVH node: its subtree's triangle range and its depth below the
+// root of its BVH (-1 for nodes of no BVH the Line Space uses).
+struct BvhSubtrees {
+  std::vector<uint32_t> first, count;
+  std::vector<int> depth;
+};
+BvhSubtrees bvh_subtrees(const Accel& accel);
+std::vector<uint32_t> ls_roots(const Accel& accel);  // the flat BVH's root, or every object's
+// The LS nodes a BVH rooted at `root` gets at (depth, n), in node order: subtrees at that depth with
+// at least min_triangles triangles and a usable box; `words` of candidates each.  n <= 0: none.
+struct LsPlacement {
+  lsk::LsNode ls;
+  uint32_t words = 0;
+};
+std::vector<LsPlacement> place_line_spaces(const Accel& accel, const BvhSubtrees& subtrees, uint32_t root, int depth, int n,
+                                           const LsOptions& options);
+size_t placement_bytes(const std::vector<LsPlacement>& placed);  // LS node records + candidates
+// What bytes_ls() counts whatever the LS nodes: the per-node LS index and the per-triangle normals.
+size_t line_space_fixed_bytes(const Accel& accel);
+// The D and N object `mesh` gets: options.objects' entry, else the structure's.
+ObjectLs object_line_space(const Accel& accel, const LsOptions& options, size_t mesh);
+// The per-triangle vertex normals the lookup's refusal test reads (2L: objects with a Line Space only).
+void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees, const LsOptions& options, Accel& accel);
+// Chooses the LS nodes, allocates empty candidates and fills ls_info (no normals).
+void layout_line_space_nodes(const LsOptions& options, const BvhSubtrees& subtrees, Accel& accel);
+// The candidate search of every laid-out LS node on all CPU threads; sets empty_shafts and seconds.
+void search_line_space(const LsOptions& options, Accel& accel);
+
 // The one packing rule: the search result of every shaft of LS node `ls_index` (an index into tris[],
 // or LS_INVALID when empty) stored as an index local to the node's triangle range in ls.bytes bytes,
 // all ones = empty.  Returns the number of empty shafts.  Distinct nodes may be packed concurrently.
 size_t pack_ls_candidates(Accel& accel, size_t ls_index, const uint32_t* prims);
+
+// The packing rule for one shaft (pack_ls_candidates applies it to every shaft of a node).  Shafts of
+// one node share words: not concurrently within a node.
+void store_ls_candidate(Accel& accel, size_t ls_index, uint32_t shaft, uint32_t prim);
 
 // The `instance` argument of ls_find_candidate() for this structure (0 for 2L, LS_INVALID for F).
 uint32_t ls_search_instance(const Accel& accel);

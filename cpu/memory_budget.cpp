@@ -30,25 +30,40 @@ size_t memory_budget(size_t max_memory) { return max_memory ? max_memory : physi
 
 StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSpec& spec, const LsOptions& ls) {
   // Triangles each BVH holds: every world triangle (flat), or each used mesh once (two-level).
-  std::vector<size_t> per_bvh;
+  // Each BVH with the D and N of its Line Space: the structure's, or its object's own (2L).
+  struct PerBvh {
+    size_t triangles;
+    int depth, n;
+  };
+  std::vector<PerBvh> per_bvh;
   if (spec.two_level()) {
     std::vector<bool> used(scene.meshes.size(), false);
     for (const Instance& inst : scene.instances) used[inst.mesh] = true;
-    for (size_t m = 0; m < scene.meshes.size(); ++m)
-      if (used[m]) per_bvh.push_back(scene.meshes[m].triangles.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+      if (!used[m]) continue;
+      const ObjectLs o = ls.objects.empty() ? ObjectLs{spec.depth, spec.subdivision} : m < ls.objects.size() ? ls.objects[m] : ObjectLs{};
+      per_bvh.push_back({scene.meshes[m].triangles.size(), o.depth, o.n});
+    }
   } else {
-    per_bvh.push_back(triangle_count(scene));
+    per_bvh.push_back({triangle_count(scene), spec.depth, spec.subdivision});
   }
-  double bvh = 0.0, nodes = 0.0, triangles = 0.0;
-  for (size_t t : per_bvh) {
-    bvh += double(t) * kBytesPerTriangle;
-    triangles += double(t);
-    if (spec.line_space()) nodes += ls_nodes_at_most(t, spec.depth, ls.min_triangles);
+  double bvh = 0.0, nodes = 0.0, triangles = 0.0, shafts = 0.0;
+  for (const PerBvh& b : per_bvh) {
+    bvh += double(b.triangles) * kBytesPerTriangle;
+    triangles += double(b.triangles);
+    if (spec.line_space() && b.n > 0) {
+      const double k = ls_nodes_at_most(b.triangles, b.depth, ls.min_triangles);
+      nodes += k;
+      shafts += k * 30.0 * std::pow(double(b.n), 4.0);
+    }
   }
   if (spec.two_level()) bvh += double(scene.instances.size()) * (sizeof(lsk::InstanceRecord) + 2 * sizeof(lsk::BvhNode) + 64);
-  const double shaft_bytes = 4.0 * 30.0 * std::pow(double(spec.subdivision), 4.0);
-  const double ls_bytes =
-      spec.line_space() ? nodes * (shaft_bytes + sizeof(lsk::LsNode)) + triangles * kLsBytesPerTriangle : 0.0;
+  // 2l-ls:auto spends at most its budget on the Line Space (the plan's bytes are exact), and its
+  // pilot holds one object's Line Space at a time, no more than the budget either.
+  const bool planned = spec.budgeted && ls.objects.empty();
+  const double ls_bytes = !spec.line_space() ? 0.0
+                          : planned         ? double(ls.budget)
+                                            : shafts * 4.0 + nodes * sizeof(lsk::LsNode) + triangles * kLsBytesPerTriangle;
   // Saturate instead of overflowing size_t (2^60 nodes of 2 GB each are representable in double).
   const double cap = double(SIZE_MAX / 4);
   StructureEstimate e;
@@ -63,12 +78,15 @@ void check_structure_budget(const Scene& scene, const StructureSpec& spec, const
   const StructureEstimate e = estimate_structure_bytes(scene, spec, ls);
   if (e.total() <= budget) return;
   std::string why = "structure '" + spec.name() + "' would take up to " + mib(double(e.total())) + " (";
-  if (spec.line_space())
-    why += "Line Space " + mib(double(e.ls_bytes)) + ": up to " + std::to_string(e.ls_nodes_at_most) + " LS nodes x " +
-           std::to_string(lsk::ls_shaft_count(uint32_t(spec.subdivision))) + " shafts; ";
+  if (spec.budgeted)
+    why += "Line Space budget " + mib(double(e.ls_bytes)) + "; ";
+  else if (spec.line_space())
+    why += "Line Space " + mib(double(e.ls_bytes)) + ": up to " + std::to_string(e.ls_nodes_at_most) + " LS nodes" +
+           (ls.objects.empty() ? " x " + std::to_string(lsk::ls_shaft_count(uint32_t(spec.subdivision))) + " shafts; " : "; ");
   why += "BVH and triangles " + mib(double(e.bvh_bytes)) + "), over the budget of " + mib(double(budget)) + ": ";
-  why += spec.line_space() ? "lower N or D, raise --ls-min-triangles, or raise --max-memory"
-                           : "use a smaller scene or raise --max-memory";
+  why += spec.budgeted       ? "lower --ls-budget or raise --max-memory"
+         : spec.line_space() ? "lower N or D, raise --ls-min-triangles, or raise --max-memory"
+                             : "use a smaller scene or raise --max-memory";
   throw InputError(why);
 }
 

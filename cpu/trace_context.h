@@ -23,9 +23,9 @@ struct TraceContext {
   const uint* ls_candidates = nullptr;
   const uvec4* tri_normals = nullptr;
   uint ls_enabled = 0;
-  uint ls_n = 0;
   float ls_cos2 = -1.0f;
   LsCounters ls_counters{};  // the shader keeps these in a private variable too
+  TraceWork trace_work{};    // box and triangle tests of the reference traversal (the shader's are dead)
 
 #include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"

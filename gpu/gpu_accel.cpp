@@ -15,7 +15,6 @@ GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
       tri_normals_(make_buffer(context, accel.tri_normals, "tri_normals")) {
   const lsk::TraceContext c = accel.context();  // the CPU's parameters, so both sides agree
   params_.ls_enabled = c.ls_enabled;
-  params_.ls_n = c.ls_n;
   params_.ls_cos2 = c.ls_cos2;
   params_.two_level = accel.spec.two_level() ? 1u : 0u;
 }

@@ -18,7 +18,7 @@ class GpuAccel {
   std::vector<const Buffer*> bindings() const;
   // Copies accel.ls_candidates again (after a search filled them).
   void upload_candidates(const Accel& accel);
-  // The parameters of lsk::TraceContext for this structure (ls_enabled, ls_n, ls_cos2, two_level).
+  // The parameters of lsk::TraceContext for this structure (ls_enabled, ls_cos2, two_level).
   ShaderParams params() const { return params_; }
 
  private:

@@ -16,39 +16,46 @@ constexpr size_t kBatchBytes = 64u << 20;  // search results per submission (bou
 void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearchTiming* timing) {
   const auto start = std::chrono::steady_clock::now();
   const size_t ls_count = accel.ls_nodes.size();
-  const uint32_t shafts = uint32_t(accel.ls_info.shafts_per_ls);
   GpuSearchTiming t;
   size_t empty = 0;
   if (ls_count > 0) {
-    const size_t bytes_per_node = size_t(shafts) * sizeof(uint32_t);
-    const size_t limit = std::min<size_t>(kBatchBytes, context.limits().maxStorageBufferRange);
-    const size_t batch = std::max<size_t>(1, std::min<size_t>({limit / bytes_per_node, ls_count, context.limits().maxComputeWorkGroupCount[1]}));
     GpuAccel gpu(context, accel);  // the candidates are not read by the search
-    Buffer prims(context, batch * bytes_per_node, "search results");
     ComputePipeline pipeline(context, spirv_ls_candidates(), 11, sizeof(ShaderParams));
     KernelTimer timer(context);
-    std::vector<const Buffer*> bindings = gpu.bindings();
-    bindings.push_back(&prims);
-    pipeline.bind(bindings);
     ShaderParams params = gpu.params();
     params.ls_enabled = 0;
-    params.ls_n = uint32_t(accel.spec.subdivision);
-    params.inv_n = 1.0f / float(params.ls_n);  // the CPU builder's value
     params.further_rays = uint32_t(accel.ls_options.further_rays);
     params.search_instance = ls_search_instance(accel);
-    std::vector<uint32_t> host(batch * shafts);
-    for (size_t first = 0; first < ls_count; first += batch) {
-      params.first_ls = uint32_t(first);
-      params.ls_count = uint32_t(std::min(batch, ls_count - first));
-      context.submit_and_wait([&](VkCommandBuffer cmd) {
-        timer.begin(cmd);
-        pipeline.record(cmd, &params, (shafts + kGroup - 1) / kGroup, params.ls_count);
-        timer.end(cmd);
-      });
-      t.kernel_seconds += timer.seconds();
-      prims.download(host.data(), size_t(params.ls_count) * bytes_per_node);
-      for (uint32_t slot = 0; slot < params.ls_count; ++slot)
-        empty += pack_ls_candidates(accel, first + slot, host.data() + size_t(slot) * shafts);
+    const size_t limit = std::min<size_t>(kBatchBytes, context.limits().maxStorageBufferRange);
+    // Consecutive LS nodes of one N share a dispatch (a structure of per-object N has several runs).
+    for (size_t run = 0; run < ls_count;) {
+      const uint32_t n = accel.ls_nodes[run].n;
+      size_t run_end = run;
+      while (run_end < ls_count && accel.ls_nodes[run_end].n == n) ++run_end;
+      const uint32_t shafts = lsk::ls_shaft_count(n);
+      const size_t bytes_per_node = size_t(shafts) * sizeof(uint32_t);
+      const size_t batch = std::max<size_t>(
+          1, std::min<size_t>({limit / bytes_per_node, run_end - run, context.limits().maxComputeWorkGroupCount[1]}));
+      Buffer prims(context, batch * bytes_per_node, "search results");
+      std::vector<const Buffer*> bindings = gpu.bindings();
+      bindings.push_back(&prims);
+      pipeline.bind(bindings);
+      params.ls_n = n;
+      std::vector<uint32_t> host(batch * shafts);
+      for (size_t first = run; first < run_end; first += batch) {
+        params.first_ls = uint32_t(first);
+        params.ls_count = uint32_t(std::min(batch, run_end - first));
+        context.submit_and_wait([&](VkCommandBuffer cmd) {
+          timer.begin(cmd);
+          pipeline.record(cmd, &params, (shafts + kGroup - 1) / kGroup, params.ls_count);
+          timer.end(cmd);
+        });
+        t.kernel_seconds += timer.seconds();
+        prims.download(host.data(), size_t(params.ls_count) * bytes_per_node);
+        for (uint32_t slot = 0; slot < params.ls_count; ++slot)
+          empty += pack_ls_candidates(accel, first + slot, host.data() + size_t(slot) * shafts);
+      }
+      run = run_end;
     }
   }
   t.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

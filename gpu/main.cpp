@@ -36,7 +36,7 @@ class GpuBackend : public Backend {
     const Accel accel = gpu::build_accel_gpu(context_, scene, spec, options, &timing);
     ls::print_build(accel, json, device_);
     if (!json && accel.spec.line_space()) {
-      const double shafts = double(accel.ls_info.ls_nodes * accel.ls_info.shafts_per_ls);
+      const double shafts = double(accel.ls_info.shafts);
       std::printf("gpu search     %.3f s wall, %.3f s kernels: %.3g shafts/s (kernels) on %s\n", timing.wall_seconds,
                   timing.kernel_seconds, timing.kernel_seconds > 0.0 ? shafts / timing.kernel_seconds : 0.0, device_.c_str());
     }

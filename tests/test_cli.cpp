@@ -63,7 +63,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 16> cases = {
+  const std::array<std::string, 20> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -80,6 +80,10 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "trace --rays /nonexistent.rays --hits " + temp("h").string(),
       "rays --kind sideways --count 10 --out " + temp("x.rays").string(),
       "frobnicate",
+      "build --structure 2l-ls:auto",                       // no --ls-budget
+      "build --structure 2l-ls:4:6 --ls-budget 10",          // --ls-budget without 2l-ls:auto
+      "build --structure 2l-ls:auto --ls-budget 0.001",      // below the fixed part
+      "build --structure 2l-ls:auto --ls-budget 10 --ls-budget-rays 0",
   };
   for (const std::string& args : cases) {
     const Run r = run(args);
@@ -119,6 +123,22 @@ TEST_CASE("rays, trace and build agree with the file formats and JSON keys", "[c
                           "build_seconds"})
     CHECK(j.contains(key));
   CHECK(j["triangles"].get<int>() > 0);
+
+  // 2l-ls:auto prints its plan: every object with its choice, predicted and measured bytes alike.
+  r = run("build --scene builtin:cornell --structure 2l-ls:auto --ls-budget 1 --ls-budget-rays 2000 --json");
+  REQUIRE(r.status == 0);
+  const auto a = nlohmann::json::parse(r.out);
+  REQUIRE(a.contains("ls_plan"));
+  const auto& plan = a["ls_plan"];
+  for (const char* key : {"budget_bytes", "fixed_bytes", "predicted_bytes", "reference", "plan", "uniform", "pilot_rays", "objects"})
+    CHECK(plan.contains(key));
+  CHECK(plan["predicted_bytes"] == a["bytes_ls"]);
+  CHECK(plan["budget_bytes"].get<size_t>() == 1000000u);
+  CHECK(a["bytes_ls"].get<size_t>() <= 1000000u);
+  CHECK(plan["objects"].size() == a["objects"].get<size_t>());
+  for (const auto& o : plan["objects"])
+    for (const char* key : {"mesh", "name", "triangles", "chosen", "reference", "bytes", "pilot_error", "pilot_saved_work", "reason"})
+      CHECK(o.contains(key));
 }
 
 TEST_CASE("render writes every image and a report", "[cli]") {

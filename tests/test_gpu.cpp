@@ -106,6 +106,20 @@ TEST_CASE("GPU candidates equal the CPU's for N in 1 2 6 10 flat and two-level a
     require_candidates_equal(objects, s);
 }
 
+TEST_CASE("GPU candidates and hits equal the CPU's for per-object D and N and for 2l-ls:auto", "[gpu]") {
+  const Scene scene = load_scene("builtin:generated:6000:4:2");
+  AccelOptions mixed = paper();
+  mixed.ls.objects.assign(scene.meshes.size(), ObjectLs{2, 3});
+  mixed.ls.objects[1] = ObjectLs{0, 5};
+  mixed.ls.objects[2] = ObjectLs{};
+  require_candidates_equal(scene, "2l-ls:0:1", mixed);
+  require_hits_equal(scene, "2l-ls:0:1", diffuse_rays(scene, 3000, 4), mixed);
+  AccelOptions budget = paper();
+  budget.ls.budget = 400000;
+  budget.ls.budget_rays = 3000;
+  require_candidates_equal(scene, "2l-ls:auto", budget);
+}
+
 TEST_CASE("GPU candidates equal the CPU's on cornell with further search rays and both candidate sizes", "[gpu]") {
   const Scene cornell = load_scene("builtin:cornell");
   AccelOptions further = paper();

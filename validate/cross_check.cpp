@@ -46,15 +46,15 @@ std::string counters_text(const lsk::LsCounters& c) {
 
 CrossCheckResult compare_candidate_arrays(const Accel& cpu, const Accel& gpu, size_t max_listed) {
   CrossCheckResult r;
-  if (cpu.ls_nodes.size() != gpu.ls_nodes.size() || cpu.ls_info.shafts_per_ls != gpu.ls_info.shafts_per_ls) {
+  if (cpu.ls_nodes.size() != gpu.ls_nodes.size() || cpu.ls_info.shafts != gpu.ls_info.shafts) {
     note(r, max_listed, "layout", std::to_string(cpu.ls_nodes.size()) + " LS nodes", std::to_string(gpu.ls_nodes.size()) + " LS nodes");
     return r;
   }
   lsk::TraceContext c = cpu.context(), g = gpu.context();
-  const uint32_t shafts = uint32_t(cpu.ls_info.shafts_per_ls);
   for (size_t i = 0; i < cpu.ls_nodes.size(); ++i) {
     const lsk::LsNode& a = cpu.ls_nodes[i];
     const lsk::LsNode& b = gpu.ls_nodes[i];
+    const uint32_t shafts = lsk::ls_shaft_count(a.n);
     if (std::memcmp(&a, &b, sizeof(a)) != 0) {
       note(r, max_listed, "LS node " + std::to_string(i) + " header", "BVH node " + std::to_string(a.node),
            "BVH node " + std::to_string(b.node) + " (headers differ)");

@@ -63,7 +63,8 @@ struct InstanceRecord {
 // A Line Space attached to one BVH node (DESIGN §3).  Its box is the node's box, widened where it is
 // thin so that a flat node (one quad) still has shafts that cross it.  Candidates are stored per shaft
 // as an index local to the node's contiguous triangle range, in `bytes` bytes (1, 2 or 4, packed
-// little-endian into 32-bit words; all ones = empty shaft).
+// little-endian into 32-bit words; all ones = empty shaft).  Each node has its own subdivision N, so
+// one structure can hold Line Spaces of different N (per-object parameters, 2l-ls:auto).
 struct LsNode {
   vec3 lo;
   uint candidates;   // first 32-bit word of this node's candidates in ls_candidates[]
@@ -73,8 +74,8 @@ struct LsNode {
   uint range_count;
   uint bytes;
   uint node;         // the BVH node it belongs to
-  uint pad0;
-  uint pad1;
+  uint n;            // subdivision N: 30 N^4 shafts
+  float inv_n;       // 1 / N, computed once by the host so that no device divides
 };
 
 // Counters of Line Space lookups, per trace call (summed by the host).
@@ -87,6 +88,13 @@ struct LsCounters {
   uint refused_beyond;    // plane hit after the current t (beyond tmax or a hit already found)
   uint refused_parallel;  // ray parallel to the candidate's plane
   uint refused_no_shaft;  // line along a face of the LS box (enters and leaves through one face)
+};
+
+// What a trace did, counted by the reference traversal (traverse_bvh.h): the work model of the Line
+// Space budget's pilot (cpu/ls_budget.h).  Never read back from a device: the shaders' copy is dead.
+struct TraceWork {
+  uint box_tests;
+  uint triangle_tests;
 };
 
 // A pinhole camera: world position, orthonormal frame, tan(vertical fov / 2), image size.

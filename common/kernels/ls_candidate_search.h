@@ -4,8 +4,10 @@
 // if it misses, rays 1..further_rays join the sub-patch points of ls_search_offsets(k), in that order.
 // Each is traced as the closed segment between its two points, closest hit, against the node's own
 // subtree only and without any Line Space.  The first that hits gives the candidate (an index into
-// tris[]); none hits: the shaft is empty (LS_INVALID).  inv_n = 1 / N, from the host.
-LS_FN uint ls_find_candidate(uint node, IN(LsNode) ls, uint shaft, uint n, float inv_n, uint further_rays, uint instance) {
+// tris[]); none hits: the shaft is empty (LS_INVALID).  N and 1 / N are the LS node's own (host-made).
+LS_FN uint ls_find_candidate(uint node, IN(LsNode) ls, uint shaft, uint further_rays, uint instance) {
+  uint n = ls.n;
+  float inv_n = ls.inv_n;
   uint start_patch;
   uint end_patch;
   ls_shaft_patches(shaft, n, start_patch, end_patch);

@@ -1,7 +1,8 @@
 // The Line Space lookup during traversal (DESIGN §3), a *context* file like traverse_bvh.h: it reads
 //   ls_nodes[] LsNode, ls_candidates[] uint, tri_normals[] uvec4 (octahedral vertex normals),
-//   tris[], tri_ids[], tri_instances[], and the parameters ls_n (N), ls_cos2 (cos^2 of the refusal
-//   angle; negative: refuse everything, empty shafts included) and the counters ls_counters.
+//   tris[], tri_ids[], tri_instances[], and the parameter ls_cos2 (cos^2 of the refusal angle;
+//   negative: refuse everything, empty shafts included) and the counters ls_counters.  N is the
+//   LS node's own (LsNode.n).
 //
 // Decided cases: the shaft comes from where the ray's *line* enters and leaves the LS box, so an
 // origin inside the box still finds its shaft.  An empty shaft means no hit in the subtree.  A
@@ -57,7 +58,7 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   uint shaft;
   float t_in;
   float t_out;
-  if (!ls_line_shaft(origin, dir, inv_dir, ls.lo, ls.hi, ls.scale, ls_n, shaft, t_in, t_out)) {
+  if (!ls_line_shaft(origin, dir, inv_dir, ls.lo, ls.hi, ls.scale, ls.n, shaft, t_in, t_out)) {
     ls_counters.refused_no_shaft += 1u;
     return LS_FALLBACK;
   }

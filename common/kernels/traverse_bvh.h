@@ -11,6 +11,7 @@
 //   instances[]      InstanceRecord, in top-level BVH order (2L only)
 //   node_ls[]        uint      LS node of each BVH node, or LS_INVALID (LS structures only)
 //   ls_enabled       uint      non-zero: use the Line Space (see ls_lookup.h for the rest)
+//   trace_work       TraceWork box and triangle tests, counted (C++ reads them; shaders ignore them)
 // Ties at equal t go to the lower (instance, triangle), so the answer does not depend on the order in
 // which the structure visits triangles.
 
@@ -20,6 +21,7 @@ LS_CONST int LS_STACK_SIZE = 64;  // the builder caps BVH depth below this
 // true when any_hit is set and a hit was found (the caller stops).
 LS_FN bool trace_leaf(uint first, uint count, IN(TriRay) tri_ray, float tmin, uint instance, bool any_hit,
                       INOUT(Hit) hit, INOUT(uint) hit_prim) {
+  trace_work.triangle_tests += count;
   for (uint i = first; i < first + count; ++i) {
     Triangle tri = tris[i];
     float t;
@@ -63,6 +65,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
   float stack_t[LS_STACK_SIZE];
   int sp = 0;
   float t_root;
+  trace_work.box_tests += 1u;
   if (!ray_box(origin, inv_dir, tmin, hit.t, nodes[root].lo, nodes[root].hi, t_root)) return false;
   uint current = root;
   while (true) {
@@ -82,6 +85,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
       uint right = node.first + 1u;
       float t_left;
       float t_right;
+      trace_work.box_tests += 2u;
       bool hit_left = ray_box(origin, inv_dir, tmin, hit.t, nodes[left].lo, nodes[left].hi, t_left);
       bool hit_right = ray_box(origin, inv_dir, tmin, hit.t, nodes[right].lo, nodes[right].hi, t_right);
       if (hit_left && hit_right) {
@@ -127,6 +131,7 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
   float stack_t[LS_STACK_SIZE];
   int sp = 0;
   float t_root;
+  trace_work.box_tests += 1u;
   bool pending = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[0].lo, top_nodes[0].hi, t_root);
   uint current = 0u;
   while (pending) {
@@ -144,6 +149,7 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
       uint right = node.first + 1u;
       float t_left;
       float t_right;
+      trace_work.box_tests += 2u;
       bool hit_left = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[left].lo, top_nodes[left].hi, t_left);
       bool hit_right = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[right].lo, top_nodes[right].hi, t_right);
       if (hit_left && hit_right) {

@@ -16,5 +16,5 @@ void main() {
   uint slot = gl_GlobalInvocationID.y;
   if (shaft >= shafts || slot >= pc.ls_count) return;
   LsNode ls = ls_nodes[pc.first_ls + slot];
-  prims[slot * shafts + shaft] = ls_find_candidate(ls.node, ls, shaft, pc.ls_n, pc.inv_n, pc.further_rays, pc.search_instance);
+  prims[slot * shafts + shaft] = ls_find_candidate(ls.node, ls, shaft, pc.further_rays, pc.search_instance);
 }

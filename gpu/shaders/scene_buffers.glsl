@@ -20,13 +20,13 @@ layout(std430, binding = 9) readonly buffer TriNormals { uvec4 tri_normals[]; };
 
 layout(push_constant) uniform Params {
   uint ls_enabled;       // trace: use the Line Space
-  uint ls_n;             // N
+  uint ls_n;             // candidates: N of this dispatch's LS nodes (the result stride)
   float ls_cos2;         // cos^2 of the refusal angle (negative: refuse all)
   uint two_level;        // trace: 2L structure
   uint any_hit;          // trace: stop at the first hit
   uint first;            // trace: first ray of this dispatch
   uint count;            // trace: rays in the buffer
-  float inv_n;           // candidates: 1 / N as the host computed it
+  float inv_n;           // unused: every LsNode carries its own 1 / N
   uint further_rays;     // candidates: search rays after the midpoint ray
   uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
   uint first_ls;         // candidates: first LS node of this dispatch
@@ -34,9 +34,9 @@ layout(push_constant) uniform Params {
 } pc;
 
 uint ls_enabled = pc.ls_enabled;
-uint ls_n = pc.ls_n;
 float ls_cos2 = pc.ls_cos2;
 LsCounters ls_counters;
+TraceWork trace_work;  // counted by the kernels, never read: the compiler drops it
 
 #include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"

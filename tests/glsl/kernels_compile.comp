@@ -26,8 +26,9 @@ layout(std430, binding = 9) readonly buffer Normals { uvec4 tri_normals[]; };
 layout(std430, binding = 10) buffer Rays { Ray rays[]; };
 layout(std430, binding = 11) buffer Hits { Hit hits[]; };
 layout(push_constant) uniform P { uint ls_enabled; uint ls_n; float ls_cos2; uint two_level; } pc;
-uint ls_enabled = pc.ls_enabled; uint ls_n = pc.ls_n; float ls_cos2 = pc.ls_cos2;
+uint ls_enabled = pc.ls_enabled; float ls_cos2 = pc.ls_cos2;
 LsCounters ls_counters;
+TraceWork trace_work;
 #include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"
 #include "kernels/ls_candidate_search.h"

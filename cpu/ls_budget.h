@@ -1,0 +1,108 @@
+// 2l-ls:auto: which objects of a two-level structure get a Line Space, and with which integration
+// depth D and subdivision N, within a memory budget (--ls-budget MB).
+//
+// Measured, not modelled.  A pilot of diffuse rays (the rays a Line Space serves: bounces >= 1) is
+// traced exactly, then for every object and every (D, N) of the menu with a Line Space on that object
+// alone.  Only the shafts those rays can look up are searched (a lookup's shaft depends on the ray's
+// line and the LS box alone), so one evaluation costs a few thousand searches whatever N and D.  Per
+// object and option this gives:
+//   error  the pilot rays whose answer moved (another instance, hit and miss swapped, or a hit point
+//          more than 1e-3 of the scene's diagonal away), over all pilot rays;
+//   work   box tests + 2.3 x triangle tests + 5.7 x Line Space lookups of those rays (the weights
+//          are the reference traversal's instruction costs, measured: README "2l-ls:auto"); the
+//          option's saved work is the exact traversal's minus its own.
+//   bytes  its LS nodes and candidates, exactly as the builder lays them out.
+// Summed over objects, the plan minimises the error subject to
+//   bytes_ls <= budget, and saved work >= that of the reference, the uniform 2l-ls:D:N of the menu
+//   with the most bytes_ls within the budget (the structure one would have used instead),
+// by Lagrangian relaxation of the work constraint (bisection on its multiplier) and the greedy
+// multiple-choice knapsack over each object's convex hull of (bytes, error - lambda x saved work),
+// then single-object moves that keep both constraints and lower the error.
+// "None" is every object's free option, so objects that gain nothing (too few triangles, never
+// reached, slower with a Line Space) get none.  When the result would err more than the reference
+// in the pilot, the reference itself is the plan.  Finally both are evaluated jointly (every object's
+// Line Space at once) on the pilot, and reported.  The menu: D in {0, 2, 4, 6, 8} x N in {2, 4, 6, 8, 10}.
+#pragma once
+
+#include "line_space_builder.h"
+#include "kernels/layouts.h"
+#include "scene.h"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace ls {
+
+struct Accel;
+
+struct LsPlanRow {
+  uint32_t mesh = 0;
+  std::string name;
+  size_t triangles = 0;
+  size_t instances = 0;
+  size_t hits = 0;         // pilot rays whose exact hit lies on this object
+  size_t relevant = 0;     // pilot rays that cross one of its instance boxes (the only ones it can change)
+  ObjectLs chosen;         // n = 0: none
+  ObjectLs reference;      // what the reference uniform structure gives it
+  size_t bytes = 0;        // its LS nodes and candidates
+  double error = 0.0;      // alone on the pilot: fraction of all pilot rays it gets wrong with `chosen`
+  double saved_work = 0.0; // alone on the pilot: work saved per pilot ray with `chosen`
+  std::string reason;      // "chosen", "no gain", "not reached", "too small"
+};
+
+// A structure's figures on the pilot, every object's Line Space at once.
+struct PilotFigures {
+  size_t bytes_ls = 0;
+  double error = 0.0;       // fraction of pilot rays whose answer moved
+  double saved_work = 0.0;  // per pilot ray, against the exact 2L-BVH
+};
+
+struct LsPlan {
+  size_t budget = 0;           // bytes of Line Space allowed (bytes_ls)
+  size_t fixed_bytes = 0;      // bytes_ls without any LS node: per-node index, per-triangle normals
+  size_t predicted_bytes = 0;  // fixed + every row's bytes: the structure's bytes_ls, exactly
+  std::string reference;       // the uniform structure the plan must be as fast as ("" when none fits)
+  bool reference_chosen = false;  // the optimiser did not beat the reference: the plan is the reference
+  double lambda = 0.0;         // the work constraint's multiplier
+  PilotFigures plan, uniform;  // joint pilot evaluations of the plan and of the reference
+  size_t pilot_rays = 0;
+  size_t evaluations = 0;      // (object, D, N) options evaluated
+  size_t shafts_searched = 0;
+  double seconds = 0.0;
+  std::vector<LsPlanRow> rows;  // every object the structure holds, by mesh index
+
+  std::vector<ObjectLs> objects(size_t meshes) const;  // LsOptions::objects of the plan
+};
+
+// The menu of (D, N) an object can get.
+std::vector<ObjectLs> ls_budget_menu();
+
+// The pilot's pieces, for tests and studies that check the plan against full builds.
+std::vector<lsk::Ray> ls_budget_pilot_rays(const Scene& scene, const Accel& exact, size_t count);
+double pilot_tolerance(const Scene& scene);  // 1e-3 of the scene's diagonal
+bool pilot_answer_moved(const lsk::Ray& ray, const lsk::Hit& got, const lsk::Hit& exact, double tolerance);
+
+// The optimiser on its own.  options[o][0] is object o's "none" (0 bytes, no error, no saved work);
+// reference[o] indexes the reference's option per object (empty: no reference, every object none).
+// Returns, per object, the option of least total error with total bytes <= room and total saved work
+// >= the reference's; the reference itself when the search finds nothing better.
+struct PlanOption {
+  ObjectLs ls;         // n = 0: none
+  size_t bytes = 0;
+  double error = 0.0;  // fraction of all pilot rays
+  double saved = 0.0;  // work saved per pilot ray
+};
+struct PlanChoice {
+  std::vector<size_t> choice;
+  double lambda = 0.0;
+  bool reference_chosen = false;
+};
+PlanChoice optimise_plan(const std::vector<std::vector<PlanOption>>& options, size_t room, const std::vector<size_t>& reference);
+
+// Plans a budgeted 2L-LS on `accel`, an exact two-level structure without its fast path (build_accel
+// calls it between the BVH and the Line Space).  Uses accel's Line Space arrays as scratch and leaves
+// them empty.  Throws InputError when the budget cannot hold even the fixed part.
+LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions& options);
+
+}  // namespace ls
