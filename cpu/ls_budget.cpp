@@ -23,6 +23,7 @@ constexpr double kMoveTolerance = 1e-3;        // of the scene's diagonal: a hit
 // reference traversal fitted over seven structures (README, "2l-ls:auto").
 constexpr double kTriangleWeight = 2.3;
 constexpr double kLookupWeight = 5.7;
+constexpr double kNegligibleWork = 0.01;  // saved work per pilot ray below which an option buys nothing
 
 struct Traced {
   std::vector<lsk::Hit> hits;
@@ -125,7 +126,7 @@ std::vector<size_t> knapsack(const std::vector<std::vector<PlanOption>>& options
     auto cost = [&](size_t k) { return opts[k].error - lambda * opts[k].saved; };
     std::vector<size_t> hull{0};  // from "none": 0 bytes, cost 0
     for (size_t k : order) {
-      if (k == 0 || cost(k) >= cost(hull.back())) continue;  // dearer and no better: never on the hull
+      if (k == 0 || !opts[k].offered || cost(k) >= cost(hull.back())) continue;  // dearer and no better: never on the hull
       while (hull.size() >= 2) {
         const size_t a = hull[hull.size() - 2], b = hull.back();
         // b lies on or above the segment a -> k: drop it.
@@ -225,7 +226,7 @@ PlanChoice optimise_plan(const std::vector<std::vector<PlanOption>>& options, si
     for (size_t o = 0; o < objects; ++o)
       for (size_t k = 0; k < options[o].size(); ++k) {
         const PlanOption &now = options[o][ch[o]], &next = options[o][k];
-        if (bytes - now.bytes + next.bytes > room || saved - now.saved + next.saved < ref_saved) continue;
+        if (!next.offered || bytes - now.bytes + next.bytes > room || saved - now.saved + next.saved < ref_saved) continue;
         if (now.error - next.error > gain) gain = now.error - next.error, move_o = o, move_k = k;
       }
     if (move_o == objects) break;
@@ -346,6 +347,9 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
         opt.saved = (exact_work - got.work) * per_ray;
         ++plan.evaluations;
       }
+      // No ray moved and under a hundredth of a box test saved per ray: nothing measurable to buy
+      // (the reference may still hold it).
+      opt.offered = !(opt.error == 0.0 && opt.saved < kNegligibleWork);
       index_of[m][e] = options_of[m].size();
       options_of[m].push_back(opt);
     }

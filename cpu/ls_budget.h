@@ -92,6 +92,8 @@ struct PlanOption {
   size_t bytes = 0;
   double error = 0.0;  // fraction of all pilot rays
   double saved = 0.0;  // work saved per pilot ray
+  bool offered = true; // false: nothing measurable to buy (no ray moved, almost no work saved); only
+                       // a reference may hold it
 };
 struct PlanChoice {
   std::vector<size_t> choice;

@@ -1,6 +1,7 @@
 // linespace-validate: measures what the Line Space's approximation costs in image error and buys in
 // speed and memory (DESIGN §7, §9).
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
+#include "budget_study.h"
 #include "cli_flags.h"
 #include "cross_check.h"
 #include "load_scene.h"
@@ -122,6 +123,15 @@ int main(int argc, char** argv) {
   image_flags.add_to(paper_cmd);
   ls_flags.add_to(paper_cmd);
 
+  std::string uniform = "2l-ls:0:10,2l-ls:4:6";
+  auto* budget_cmd = app.add_subcommand("budget", "2l-ls:auto against uniform 2l-ls:D:N of the same memory: RMSE, MRays/s, the choice");
+  budget_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
+  budget_cmd->add_option("--uniform", uniform, "uniform 2l-ls:D:N structures; each one's bytes_ls is a budget")->capture_default_str();
+  budget_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
+  budget_cmd->add_option("--out", out_dir, "folder for budget.{md,csv,json}")->default_val("out/budget");
+  image_flags.add_to(budget_cmd);
+  ls_flags.add_to(budget_cmd);
+
   // CPU-versus-GPU cross-checks (issue 5): exit 1 on any difference.
   validate::CrossCheckCommand check;
   std::vector<float> check_offset;
@@ -185,6 +195,17 @@ int main(int argc, char** argv) {
         plot_sweep(out_dir);
         std::printf("wrote %s/{tradeoff.png, tradeoff.svg}\n", out_dir.c_str());
       }
+    } else if (*budget_cmd) {
+      const std::vector<StructureSpec> specs = parse_structure_list(uniform);
+      const ImageSettings settings = image_flags.settings();
+      const Scene scene = load_scene(scene_spec);
+      const AccelOptions accel_options = ls_flags.options();
+      auto renderer = make_study_renderer(device, scene, accel_options);
+      const BudgetStudy study = run_budget_study(*renderer, scene_spec, specs, settings, accel_options.ls, log_line);
+      write_budget_study(out_dir, study);
+      std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\n%s\nwrote %s/{budget.md, budget.csv, budget.json}\n", scene_spec.c_str(),
+                  settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
+                  study.table().markdown().c_str(), study.choices().markdown().c_str(), out_dir.c_str());
     } else if (*paper_cmd) {
       PaperOptions options;
       options.scenes = scene_list(scenes);

@@ -1,0 +1,54 @@
+// `linespace-validate budget`: the per-object choice of 2l-ls:auto (cpu/ls_budget.h) against uniform
+// parameters of the same memory (issue 8.2).  For each uniform 2l-ls:D:N: its bytes_ls become the
+// budget of a 2l-ls:auto, and both are rendered from each start bounce against the all-exact reference
+// with the same random numbers (the measurement `rmse` makes): RMSE per start bounce, indirect MRays/s,
+// memory (the plan's predicted bytes beside the built structure's), and the pilot's figures.
+#pragma once
+
+#include "ls_budget.h"
+#include "measure.h"
+#include "rmse_study.h"
+#include "table.h"
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace ls {
+
+struct BudgetSide {
+  std::string structure;
+  std::vector<double> rmse;  // from bounce 1..B
+  double mrays_per_s = 0.0;  // with the structure from bounce 1
+  size_t bytes_ls = 0;
+  double build_seconds = 0.0;
+};
+
+struct BudgetComparison {
+  std::string uniform_name;
+  size_t budget = 0;         // the uniform's bytes_ls
+  BudgetSide uniform, planned;
+  LsPlan plan;               // of the 2l-ls:auto
+  std::string refused;       // non-empty: the uniform structure was refused (memory), no figures
+  bool lower_rmse() const;   // at every start bounce
+};
+
+struct BudgetStudy {
+  std::string scene, device;
+  ImageSettings settings;
+  double reference_mrays_per_s = 0.0;
+  size_t reference_bytes = 0;
+  std::vector<BudgetComparison> rows;
+
+  Table table() const;       // one line per structure
+  Table choices() const;     // the plans, object by object, beside the uniform's D and N
+  nlohmann::json json() const;
+};
+
+BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, const std::vector<StructureSpec>& uniform,
+                             const ImageSettings& settings, const LsOptions& ls, const Log& log);
+
+// budget.md (both tables), budget.csv (the first), budget.json into dir.
+void write_budget_study(const std::string& dir, const BudgetStudy& study);
+
+}  // namespace ls
