@@ -99,7 +99,14 @@ size_t estimate_line_space_bytes(size_t ls_nodes, int n) {
   return size_t(double(ls_nodes) * (shafts * 4.0 + double(sizeof(lsk::LsNode))));
 }
 
+namespace {
+std::atomic<size_t> layouts{0};
+}  // namespace
+
+size_t line_space_layouts() { return layouts.load(); }
+
 void layout_line_space(const Scene& scene, const LsOptions& options, Accel& accel) {
+  ++layouts;
   const int depth = accel.spec.depth;
   const uint32_t n = uint32_t(accel.spec.subdivision);
   const uint32_t shafts = lsk::ls_shaft_count(n);

@@ -60,4 +60,8 @@ size_t estimate_line_space_bytes(size_t ls_nodes, int n);
 
 size_t physical_memory_bytes();
 
+// How many Line Spaces layout_line_space() has laid out in this process (every CPU or GPU build goes
+// through it): the animation tests check that a top-level update builds none.
+size_t line_space_layouts();
+
 }  // namespace ls
