@@ -136,29 +136,30 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
   if (!(frames.fps > 0.0 && frames.fps <= 1000.0))
     throw InputError("--fps " + std::to_string(frames.fps) + " must be in (0, 1000]");
   const SceneRig& rig = scene.rig;
+  if (rig.animations.empty() && frames.animation != 0)
+    throw InputError(scene_spec + ": --animation " + std::to_string(frames.animation) + ", but the scene has no animation");
+  check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
+  const auto time_of = [&](int f) { return double(f) / frames.fps; };
+  // Refuses what cannot be posed (a missing animation, weights channels, a singular pose on any frame)
+  // before anything is built or said: posing is cheap beside rendering.
+  for (int f = frames.range.last; f >= frames.range.first; --f) {
+    if ((f & 63) == 0) throw_if_interrupted();
+    pose_scene(scene, time_of(f), frames.animation);
+  }
   std::string animation_name;
   double duration = 0.0;
   if (rig.animations.empty()) {
-    if (frames.animation != 0)
-      throw InputError(scene_spec + ": --animation " + std::to_string(frames.animation) + ", but the scene has no animation");
     std::fprintf(stderr, "note: %s has no animation: every frame renders the same pose\n", scene_spec.c_str());
   } else {
-    if (frames.animation >= rig.animations.size())
-      throw InputError(scene_spec + ": animation " + std::to_string(frames.animation) + " does not exist (the scene has " +
-                       std::to_string(rig.animations.size()) + ")");
     const Animation& a = rig.animations[frames.animation];
     animation_name = a.name;
     duration = a.duration();
     if (rig.animations.size() > 1)
       std::fprintf(stderr, "note: %s has %zu animations; rendering animation %zu '%s' (--animation N picks another)\n",
                    scene_spec.c_str(), rig.animations.size(), frames.animation, a.name.c_str());
-    if (double(frames.range.last) / frames.fps > duration)
+    if (time_of(frames.range.last) > duration)
       std::fprintf(stderr, "note: frames after t = %g s (the animation's end) hold its last pose\n", duration);
   }
-  check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
-  const auto time_of = [&](int f) { return double(f) / frames.fps; };
-  // Refuses what cannot be posed (weights channels, a singular pose) before anything is built.
-  pose_scene(scene, time_of(frames.range.first), frames.animation);
 
   // The schedule's distinct structures, in schedule order; the two-level ones built once, here.
   std::vector<StructureSpec> distinct;
