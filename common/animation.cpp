@@ -127,7 +127,8 @@ void pose_scene(Scene& scene, double t, size_t index) {
   const Animation& animation = rig.animations[index];
   if (animation.weight_channels > 0)
     throw InputError(where + ": animation " + std::to_string(index) + " animates morph-target weights (" +
-                     std::to_string(animation.weight_channels) + " channels), which rigid animation cannot pose");
+                     std::to_string(animation.weight_channels) + (animation.weight_channels == 1 ? " channel" : " channels") +
+                     "), which rigid animation cannot pose");
 
   std::vector<RigNode> posed = rig.nodes;
   for (const AnimationChannel& c : animation.channels) {

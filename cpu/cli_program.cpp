@@ -159,7 +159,7 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   if (!scene.rig.animations.empty()) {
     bool weights = false;
     for (const Animation& a : scene.rig.animations) weights = weights || a.weight_channels > 0;
-    std::fprintf(stderr, "note: %s is animated; a still render shows it unposed%s (--frames A:B renders the animation)\n",
+    std::fprintf(stderr, "note: %s is animated; a still render does not pose it%s (--frames A:B renders the animation)\n",
                  v.scene.c_str(), weights ? " and ignores its morph-target weight channels" : "");
   }
   const RenderOptions options = render_options(v);

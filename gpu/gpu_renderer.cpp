@@ -66,14 +66,17 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     const std::string name = options.schedule.at(k).name();
     const auto it = structures.find(name);
     if (it == structures.end()) throw InputError("render: structure '" + name + "' was not built");
-    const auto on_device = resident ? resident->find(&it->second) : std::map<const Accel*, const GpuAccel*>::const_iterator{};
-    if (resident && on_device != resident->end()) {
-      accel[size_t(k)] = on_device->second;
-    } else {
+    const GpuAccel* on_device = nullptr;
+    if (resident) {
+      const auto r = resident->find(&it->second);
+      if (r != resident->end()) on_device = r->second;
+    }
+    if (!on_device) {
       auto& up = uploaded[&it->second];
       if (!up) up = std::make_unique<GpuAccel>(context, it->second);
-      accel[size_t(k)] = up.get();
+      on_device = up.get();
     }
+    accel[size_t(k)] = on_device;
     line_space[size_t(k)] = it->second.spec.line_space();
     result.bounces[size_t(k)].structure = name;
   }
