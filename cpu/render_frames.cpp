@@ -47,10 +47,11 @@ std::string frame_name(int f) {
   return buf;
 }
 
-// Written under a temporary name and renamed: never half a file, also when interrupted.
-void write_json(const fs::path& path, const json& j) {
+// Written under a temporary name and renamed: never half a file, also when interrupted.  A pending
+// interrupt stops it before it starts, unless `while_interrupted` (the last listing of a stopped run).
+void write_json(const fs::path& path, const json& j, bool while_interrupted = false) {
   const std::string target = path.string(), temp = target + ".partial";
-  throw_if_interrupted();
+  if (!while_interrupted) throw_if_interrupted();
   set_partial_file(&temp);
   {
     std::ofstream f(temp);
@@ -206,100 +207,116 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
   const fs::path out(out_dir);
   std::set<std::string> refused;  // flat counterparts over the memory budget: not tried again
   json done = json::array();
-  const int total = frames.range.last - frames.range.first + 1;
-  for (int f = frames.range.first; f <= frames.range.last; ++f) {
-    throw_if_interrupted();
-    const double t = time_of(f);
-    pose_scene(scene, t, frames.animation);
-
-    // Bring every structure to this pose: 2L by its top level, flat from scratch.
-    std::map<std::string, double> rebuilt;
-    json updates = json::array();
-    for (size_t i = 0; i < distinct.size(); ++i) {
-      const StructureSpec& spec = distinct[i];
-      const std::string name = spec.name();
-      double s;
-      if (spec.two_level()) {
-        s = timed([&] { backend.update_top_level(scene, built.at(name), frames.top_level); });
-      } else {
-        s = timed([&] { built.insert_or_assign(name, backend.build(scene, spec, accel_options)); });
-        rebuilt[name] = s;
-      }
-      updates.push_back({{"structure", name}, {"update", series[i].update}, {"seconds", s}});
-      series[i].update_seconds.push_back(s);
-    }
-    // What rebuilding the flat counterpart of each 2L structure takes on this pose.
-    for (size_t i = 0; i < distinct.size(); ++i) {
-      if (series[i].flat.empty()) continue;
-      const std::string& flat = series[i].flat;
-      json& entry = updates[i];
-      entry["flat_structure"] = flat;
-      double s = -1.0;
-      if (rebuilt.count(flat)) {
-        s = rebuilt[flat];
-      } else if (!refused.count(flat)) {
-        try {
-          s = timed([&] { backend.build(scene, flat_counterpart(distinct[i]), accel_options); });
-        } catch (const InputError& e) {
-          refused.insert(flat);
-          std::fprintf(stderr, "note: no flat comparison for %s: %s\n", series[i].structure.c_str(), e.what());
-        }
-      }
-      if (s < 0.0) {
-        entry["flat_rebuild_seconds"] = nullptr;
-        continue;
-      }
-      entry["flat_rebuild_seconds"] = s;
-      entry["flat_over_update"] = entry["seconds"].get<double>() > 0.0 ? s / entry["seconds"].get<double>() : 0.0;
-      series[i].flat_seconds.push_back(s);
-    }
-
-    const RenderResult result = backend.render(scene, built, options, progress);
-    const std::string name = frame_name(f);
-    json frame{{"frame", f},
-               {"time", t},
-               {"dir", name},
-               {"updates", updates},
-               {"render_seconds", result.seconds},
-               {"indirect_rays", result.indirect_rays()},
-               {"indirect_seconds", result.indirect_seconds()},
-               {"indirect_mrays_per_s", result.indirect_mrays_per_s()}};
-    RenderReportContext ctx{scene_spec, options.schedule.name(), options.spp, options.seed, &built, device, frame};
-    // A whole frame or none: written aside, renamed when complete.
-    const fs::path partial = out / (name + ".partial"), final_dir = out / name;
-    fs::remove_all(partial);
-    try {
-      write_render_outputs(partial.string(), result, ctx);
-    } catch (...) {
-      fs::remove_all(partial, ec);
-      throw;
-    }
-    fs::remove_all(final_dir);
-    fs::rename(partial, final_dir);
-
-    done.push_back(frame);
+  size_t listed = 0;  // frames in the frames.json on disk
+  auto listed_at = std::chrono::steady_clock::now();
+  const auto write_list = [&](bool complete, bool while_interrupted) {
     json list = header;
     list["frames"] = done;
     list["frames_done"] = done.size();
-    list["complete"] = f == frames.range.last;
+    list["complete"] = complete;
     list["summary"] = summary_json(series);
-    write_json(out / "frames.json", list);
+    write_json(out / "frames.json", list, while_interrupted);
+    listed = done.size();
+    listed_at = std::chrono::steady_clock::now();
+  };
+  const int total = frames.range.last - frames.range.first + 1;
+  try {
+    for (int f = frames.range.first; f <= frames.range.last; ++f) {
+      throw_if_interrupted();
+      const double t = time_of(f);
+      pose_scene(scene, t, frames.animation);
 
-    if (!frames.quiet) {
-      char lead[96];
-      std::snprintf(lead, sizeof(lead), "frame %d [%d/%d] t = %.6g s:", f, f - frames.range.first + 1, total, t);
-      std::string line = lead;
-      for (const json& u : updates) {
-        line += " " + u["structure"].get<std::string>() + " " + (u["update"] == "top-level" ? "top level " : "rebuild ") +
-                ms(u["seconds"].get<double>()) + " ms";
-        if (u.contains("flat_rebuild_seconds") && !u["flat_rebuild_seconds"].is_null())
-          line += " (" + u["flat_structure"].get<std::string>() + " rebuild " + ms(u["flat_rebuild_seconds"].get<double>()) + " ms)";
-        line += ";";
+      // Bring every structure to this pose: 2L by its top level, flat from scratch.
+      std::map<std::string, double> rebuilt;
+      json updates = json::array();
+      for (size_t i = 0; i < distinct.size(); ++i) {
+        const StructureSpec& spec = distinct[i];
+        const std::string name = spec.name();
+        double s;
+        if (spec.two_level()) {
+          s = timed([&] { backend.update_top_level(scene, built.at(name), frames.top_level); });
+        } else {
+          s = timed([&] { built.insert_or_assign(name, backend.build(scene, spec, accel_options)); });
+          rebuilt[name] = s;
+        }
+        updates.push_back({{"structure", name}, {"update", series[i].update}, {"seconds", s}});
+        series[i].update_seconds.push_back(s);
       }
-      char tail[96];
-      std::snprintf(tail, sizeof(tail), " render %.2f s, indirect %.2f MRays/s", result.seconds, result.indirect_mrays_per_s());
-      std::fprintf(stderr, "%s%s\n", line.c_str(), tail);
+      // What rebuilding the flat counterpart of each 2L structure takes on this pose.
+      for (size_t i = 0; i < distinct.size(); ++i) {
+        if (series[i].flat.empty()) continue;
+        const std::string& flat = series[i].flat;
+        json& entry = updates[i];
+        entry["flat_structure"] = flat;
+        double s = -1.0;
+        if (rebuilt.count(flat)) {
+          s = rebuilt[flat];
+        } else if (!refused.count(flat)) {
+          try {
+            s = timed([&] { backend.build(scene, flat_counterpart(distinct[i]), accel_options); });
+          } catch (const InputError& e) {
+            refused.insert(flat);
+            std::fprintf(stderr, "note: no flat comparison for %s: %s\n", series[i].structure.c_str(), e.what());
+          }
+        }
+        if (s < 0.0) {
+          entry["flat_rebuild_seconds"] = nullptr;
+          continue;
+        }
+        entry["flat_rebuild_seconds"] = s;
+        entry["flat_over_update"] = entry["seconds"].get<double>() > 0.0 ? s / entry["seconds"].get<double>() : 0.0;
+        series[i].flat_seconds.push_back(s);
+      }
+
+      const RenderResult result = backend.render(scene, built, options, progress);
+      const std::string name = frame_name(f);
+      json frame{{"frame", f},
+                 {"time", t},
+                 {"dir", name},
+                 {"updates", updates},
+                 {"render_seconds", result.seconds},
+                 {"indirect_rays", result.indirect_rays()},
+                 {"indirect_seconds", result.indirect_seconds()},
+                 {"indirect_mrays_per_s", result.indirect_mrays_per_s()}};
+      RenderReportContext ctx{scene_spec, options.schedule.name(), options.spp, options.seed, &built, device, frame};
+      // A whole frame or none: written aside, renamed when complete.
+      const fs::path partial = out / (name + ".partial"), final_dir = out / name;
+      fs::remove_all(partial);
+      try {
+        write_render_outputs(partial.string(), result, ctx);
+      } catch (...) {
+        fs::remove_all(partial, ec);
+        throw;
+      }
+      fs::remove_all(final_dir);
+      fs::rename(partial, final_dir);
+
+      done.push_back(frame);
+      // After every frame, but past 100 frames at most once a second (rewriting the whole list after
+      // each of 10,000 quick frames would write gigabytes); a stopped run lists its frames below.
+      const bool last = f == frames.range.last;
+      if (last || done.size() <= 100 || std::chrono::steady_clock::now() - listed_at >= std::chrono::seconds(1))
+        write_list(last, false);
+
+      if (!frames.quiet) {
+        char lead[96];
+        std::snprintf(lead, sizeof(lead), "frame %d [%d/%d] t = %.6g s:", f, f - frames.range.first + 1, total, t);
+        std::string line = lead;
+        for (const json& u : updates) {
+          line += " " + u["structure"].get<std::string>() + " " + (u["update"] == "top-level" ? "top level " : "rebuild ") +
+                  ms(u["seconds"].get<double>()) + " ms";
+          if (u.contains("flat_rebuild_seconds") && !u["flat_rebuild_seconds"].is_null())
+            line += " (" + u["flat_structure"].get<std::string>() + " rebuild " + ms(u["flat_rebuild_seconds"].get<double>()) + " ms)";
+          line += ";";
+        }
+        char tail[96];
+        std::snprintf(tail, sizeof(tail), " render %.2f s, indirect %.2f MRays/s", result.seconds, result.indirect_mrays_per_s());
+        std::fprintf(stderr, "%s%s\n", line.c_str(), tail);
+      }
     }
+  } catch (const Interrupted&) {
+    if (listed < done.size()) write_list(false, true);  // exactly the whole frames on disk
+    throw;
   }
 
   // The table: one row per frame, update milliseconds per structure and the flat comparison.

@@ -9,9 +9,10 @@
 // own rebuild when the schedule holds it; skipped with --no-flat-comparison).
 //
 // Writes OUT/frame_NNNN/ (the files of a single render, report.json with a "frame" entry) and
-// OUT/frames.json (rewritten after every frame, "complete" true once the last one is written), a table
-// on stdout and one line per frame on stderr.  A frame is rendered into frame_NNNN.partial/ and renamed
-// when whole, so an interrupt (exit 130) leaves only whole frames and a frames.json that lists them.
+// OUT/frames.json (rewritten after every frame, past 100 frames at most once a second; "complete" true
+// once the last one is written), a table on stdout and one line per frame on stderr.  A frame is
+// rendered into frame_NNNN.partial/ and renamed when whole, and an interrupt (exit 130) lists the
+// frames once more: it leaves only whole frames and a frames.json that lists exactly them.
 #pragma once
 
 #include "cli_program.h"
