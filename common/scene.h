@@ -5,6 +5,8 @@
 // order instances by glTF node index); triangle id = index into Mesh::triangles.
 #pragma once
 
+#include "animation.h"
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -54,6 +56,7 @@ struct Scene {
   std::vector<Material> materials;
   Camera camera;
   glm::vec3 background{0.0f};          // radiance of rays that leave the scene (a default light for meshes)
+  SceneRig rig;                        // glTF nodes and animations (animation.h); empty for static scenes
 };
 
 struct Bounds {

@@ -2,10 +2,12 @@
 
 #include "ls_budget.h"
 #include "memory_budget.h"
+#include "top_level_update.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -110,26 +112,7 @@ void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& 
   }
 
   // The top level over instance boxes (each object's root box carried into the world).
-  std::vector<Bounds> boxes;
-  for (const Instance& inst : scene.instances) {
-    const lsk::BvhNode& root = accel.nodes[accel.object_roots[inst.mesh]];
-    boxes.push_back(transform_bounds(inst.object_to_world, Bounds{root.lo, root.hi}));
-  }
-  BvhBuildResult top = build_bvh(boxes, options);
-  accel.top_nodes = std::move(top.nodes);
-  for (uint32_t id : top.order) {
-    const Instance& inst = scene.instances[id];
-    const glm::mat4 w2o = glm::mat4(glm::inverse(glm::dmat4(inst.object_to_world)));
-    lsk::InstanceRecord rec;
-    rec.world_to_object0 = glm::vec4(w2o[0][0], w2o[1][0], w2o[2][0], w2o[3][0]);
-    rec.world_to_object1 = glm::vec4(w2o[0][1], w2o[1][1], w2o[2][1], w2o[3][1]);
-    rec.world_to_object2 = glm::vec4(w2o[0][2], w2o[1][2], w2o[2][2], w2o[3][2]);
-    rec.root = accel.object_roots[inst.mesh];
-    rec.instance = id;
-    rec.object = inst.mesh;
-    rec.pad = 0;
-    accel.instances.push_back(rec);
-  }
+  build_top_level(scene, options, accel);
 }
 
 }  // namespace
@@ -174,7 +157,10 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
   check_structure_budget(scene, spec, options.ls);
   const auto start = std::chrono::steady_clock::now();
   Accel accel;
+  static std::atomic<uint64_t> builds{0};
+  accel.build_id = ++builds;
   accel.spec = spec;
+  accel.bvh_options = options.bvh;
   accel.instance_count = scene.instances.size();
   accel.world_triangles = triangle_count(scene);
   if (spec.two_level())

@@ -32,6 +32,11 @@ struct Accel {
   size_t world_triangles = 0;
   int max_depth = 0;                        // deepest BVH (object BVHs for 2L)
   double build_seconds = 0.0;               // everything, Line Space included
+  BvhBuildOptions bvh_options;              // what the BVHs were built with (the top level is rebuilt with it)
+  // Which build this is (unique per build_accel call in a process; 0 for hand-made structures) and
+  // how often its top level was updated since (top_level_update.h): device copies check both.
+  uint64_t build_id = 0;
+  uint32_t top_level_version = 0;
 
   // Line Space (F-LS, 2L-LS): see line_space_builder.h and common/kernels/ls_lookup.h.
   std::vector<uint32_t> node_ls;            // per BVH node: its LsNode, or LS_INVALID

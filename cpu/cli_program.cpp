@@ -7,6 +7,7 @@
 #include "memory_budget.h"
 #include "ray_files.h"
 #include "ray_generators.h"
+#include "render_frames.h"
 #include "render_output.h"
 
 #include <CLI/CLI.hpp>
@@ -33,6 +34,10 @@ struct Values {
   std::string schedule = "bvh", size = "512x512", out_dir = "out/render";
   int spp = 16, bounces = 3;
   bool quiet = false;
+  std::string frames, top_level = "rebuild";  // render --frames A:B (render_frames.h)
+  double fps = 24.0;
+  size_t animation = 0;
+  bool no_flat_comparison = false;
   std::string structures = "bvh,2l-bvh";
   int repeats = 5;
   std::string bench_kind = "diffuse";
@@ -84,6 +89,14 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.render->add_option("--out", v.out_dir, "output folder")->capture_default_str();
   c.render->add_option("--seed", v.seed)->capture_default_str();
   c.render->add_flag("--quiet", v.quiet, "no progress bar");
+  CLI::Option* frames = c.render->add_option(
+      "--frames", v.frames, "render frames A..B of the scene's animation (A:B or N) into OUT/frame_NNNN/ and OUT/frames.json");
+  c.render->add_option("--fps", v.fps, "frames per second: frame f is posed at t = f / fps")->capture_default_str()->needs(frames);
+  c.render->add_option("--animation", v.animation, "which of the scene's animations --frames renders (index)")
+      ->capture_default_str()->needs(frames);
+  c.render->add_flag("--no-flat-comparison", v.no_flat_comparison, "do not time a flat rebuild beside each 2L update")->needs(frames);
+  c.render->add_option("--top-level-update", v.top_level, "how 2L structures follow the animation: rebuild or refit their top level")
+      ->capture_default_str()->check(CLI::IsMember({"rebuild", "refit"}))->needs(frames);
 
   c.bench = app.add_subcommand("bench", "MRays/s of each structure on the same rays, in one run");
   common(c.bench, true);
@@ -106,7 +119,7 @@ std::vector<lsk::Ray> make_rays(const Scene& scene, const std::string& kind, siz
   return generate_rays(scene, exact, k, count, seed);
 }
 
-void run_render(const Scene& scene, const Values& v, Backend& backend) {
+RenderOptions render_options(const Values& v) {
   RenderOptions options;
   options.schedule = parse_schedule(v.schedule);
   const Size size = parse_size(v.size);
@@ -115,22 +128,50 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   options.spp = v.spp;
   options.bounces = v.bounces;
   options.seed = v.seed;
-  const AccelOptions accel_options = v.ls.options();
-  check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
-  std::map<std::string, Accel> built;
-  for (const StructureSpec& spec : options.schedule.per_bounce)
-    if (!built.count(spec.name())) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
+  return options;
+}
+
+Progress progress_bar(const Values& v) {
   const bool show = !v.quiet && isatty(2);
-  const Progress progress = [&](int done, int total) {
+  return [show](int done, int total) {
     if (!show) return;
     const int width = 30, filled = done * width / total;
     std::fprintf(stderr, "\rrender [%s%s] %d/%d samples", std::string(size_t(filled), '#').c_str(),
                  std::string(size_t(width - filled), ' ').c_str(), done, total);
     if (done == total) std::fprintf(stderr, "\n");
   };
+}
+
+// render --frames: the animation, frame by frame (render_frames.h).
+void run_render_frames(const Scene& scene, const Values& v, Backend& backend) {
+  FramesOptions frames;
+  frames.range = parse_frames(v.frames);
+  frames.fps = v.fps;
+  frames.animation = v.animation;
+  frames.flat_comparison = !v.no_flat_comparison;
+  frames.top_level = parse_top_level_mode(v.top_level);
+  frames.quiet = v.quiet;
+  render_frames(scene, v.scene, render_options(v), v.ls.options(), frames, v.out_dir, backend, progress_bar(v));
+}
+
+void run_render(const Scene& scene, const Values& v, Backend& backend) {
+  if (!v.frames.empty()) return run_render_frames(scene, v, backend);
+  if (!scene.rig.animations.empty()) {
+    bool weights = false;
+    for (const Animation& a : scene.rig.animations) weights = weights || a.weight_channels > 0;
+    std::fprintf(stderr, "note: %s is animated; a still render does not pose it%s (--frames A:B renders the animation)\n",
+                 v.scene.c_str(), weights ? " and ignores its morph-target weight channels" : "");
+  }
+  const RenderOptions options = render_options(v);
+  const AccelOptions accel_options = v.ls.options();
+  check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
+  std::map<std::string, Accel> built;
+  for (const StructureSpec& spec : options.schedule.per_bounce)
+    if (!built.count(spec.name())) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
+  const Progress progress = progress_bar(v);
   const RenderResult result = backend.render(scene, built, options, progress);
   const std::string device = backend.device();
-  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device};
+  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr};
   write_render_outputs(v.out_dir, result, ctx);
   std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
   std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",

@@ -6,6 +6,7 @@
 
 #include "accel.h"
 #include "path_tracer.h"
+#include "top_level_update.h"
 
 #include <functional>
 #include <map>
@@ -31,6 +32,12 @@ class Backend {
   // `bench`: times and prints (text or JSON).
   virtual void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs,
                      int repeats, const AccelOptions& options, bool any_hit, bool json) = 0;
+  // `render --frames` (render_frames.h): brings a two-level structure made by build() to a posed scene
+  // by its top level alone (top_level_update.h).  A backend with a device copy of the structure
+  // refreshes that copy's top level here, and nothing else of it.
+  virtual TopLevelUpdate update_top_level(const Scene& posed, Accel& accel, TopLevelMode mode) {
+    return ls::update_top_level(posed, accel, mode);
+  }
 };
 
 struct ProgramInfo {

@@ -280,39 +280,61 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
   }
 }
 
+// What the fast path keeps of the object level: the wide trees of the object BVHs (or of the flat
+// BVH) and the SoA triangle blocks.  Shared by the tracers of every top level (animation).
+template <int K>
+struct ObjectPart {
+  WideTree<K> tree;
+  std::vector<TriBlock> blocks;
+};
+
 template <int K>
 class WideTracer final : public FastTracer {
  public:
   WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()) {
     const std::vector<uint32_t> none;
     const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
+    auto part = std::make_shared<ObjectPart<K>>();
     if (two_level_) {
-      objects_ = build_wide_tree<K>(accel.nodes, node_ls, accel.object_roots);
+      part->tree = build_wide_tree<K>(accel.nodes, node_ls, accel.object_roots);
       top_ = build_wide_tree<K>(accel.top_nodes, none, {0u});
     } else {
-      objects_ = build_wide_tree<K>(accel.nodes, node_ls, {0u});
+      part->tree = build_wide_tree<K>(accel.nodes, node_ls, {0u});
     }
     // SoA copies of each leaf's triangles, four to a block: offsets first, then filled in parallel.
     size_t total = 0;
-    for (WideNode<K>& node : objects_.nodes)
+    for (WideNode<K>& node : part->tree.nodes)
       for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
         if (node.count[lane] > 0) {
           node.block[lane] = uint32_t(total);
           total += (node.count[lane] + 3u) / 4u;
         }
-    blocks_.assign(total, TriBlock{});
-    tbb::parallel_for(size_t(0), objects_.nodes.size(), [&](size_t n) {
-      const WideNode<K>& node = objects_.nodes[n];
+    part->blocks.assign(total, TriBlock{});
+    tbb::parallel_for(size_t(0), part->tree.nodes.size(), [&](size_t n) {
+      const WideNode<K>& node = part->tree.nodes[n];
       for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
         for (uint32_t k = 0; k < node.count[lane]; ++k) {
           const lsk::Triangle& t = accel.tris[node.first[lane] + k];
-          TriBlock& block = blocks_[node.block[lane] + k / 4u];
+          TriBlock& block = part->blocks[node.block[lane] + k / 4u];
           const glm::vec4* v[3] = {&t.v0, &t.v1, &t.v2};
           for (int i = 0; i < 3; ++i)
             for (int a = 0; a < 3; ++a) block.v[i][a][k % 4u] = (*v[i])[a];
         }
     });
+    part_ = std::move(part);
+    blocks_ = part_->blocks.data();
   }
+
+  // The object part of `other`, a new wide top tree over accel.top_nodes.
+  WideTracer(const WideTracer& other, const Accel& accel)
+      : two_level_(other.two_level_), part_(other.part_), blocks_(other.blocks_),
+        top_(build_wide_tree<K>(accel.top_nodes, {}, {0u})) {}
+
+  std::shared_ptr<const FastTracer> with_top_level(const Accel& accel) const override {
+    if (!two_level_) return std::make_shared<WideTracer>(*this);
+    return std::make_shared<WideTracer>(*this, accel);
+  }
+  const void* object_part() const override { return part_.get(); }
 
   void trace(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, bool any_hit) const override {
     if (two_level_)
@@ -321,7 +343,7 @@ class WideTracer final : public FastTracer {
       for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], any_hit);
   }
 
-  size_t bytes() const override { return objects_.bytes() + top_.bytes() + blocks_.size() * sizeof(TriBlock); }
+  size_t bytes() const override { return part_->tree.bytes() + top_.bytes() + part_->blocks.size() * sizeof(TriBlock); }
   int width() const override { return 1 << K; }
 
  private:
@@ -343,13 +365,13 @@ class WideTracer final : public FastTracer {
                                             : trace_leaf(c, block, first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim);
       return stop ? Visit::Stop : Visit::Skip;
     };
-    const uint w = objects_.wide_of[root];
+    const uint w = part_->tree.wide_of[root];
     if (w == LS_INVALID) {  // a root that is a leaf has no wide node
       const lsk::BvhNode& node = c.nodes[root];
       return visit(use_ls ? c.node_ls[root] : LS_INVALID, true, node.first, node.count, LS_INVALID) == Visit::Stop;
     }
     auto leaf_block = [&](uint block) { return reinterpret_cast<const char*>(&blocks_[block]); };
-    return walk(objects_, w, make_box_ray(origin, inv_dir), tmin, hit, visit, leaf_block);
+    return walk(part_->tree, w, make_box_ray(origin, inv_dir), tmin, hit, visit, leaf_block);
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
@@ -418,9 +440,9 @@ class WideTracer final : public FastTracer {
   }
 
   bool two_level_;
-  WideTree<K> objects_;
+  std::shared_ptr<const ObjectPart<K>> part_;
+  const TriBlock* blocks_ = nullptr;  // part_->blocks.data(): one load less on the hot path
   WideTree<K> top_;
-  std::vector<TriBlock> blocks_;
 };
 
 }  // namespace

@@ -30,6 +30,12 @@ class FastTracer {
                      bool any_hit) const = 0;
   virtual size_t bytes() const = 0;  // the wide nodes and their index
   virtual int width() const = 0;     // 4 or 8
+  // A tracer for the same Accel after its top level was rebuilt or refitted (top_level_update.h):
+  // the wide top tree is collapsed anew, the object wide trees and triangle blocks are shared, not
+  // copied.  Flat structures have no top level: the tracer is returned as it is.
+  virtual std::shared_ptr<const FastTracer> with_top_level(const Accel& accel) const = 0;
+  // The address of the object part (object wide trees and triangle blocks): tests check it stays.
+  virtual const void* object_part() const = 0;
 };
 
 // width: 4 (treelets of 2 levels) or 8 (3 levels).  The Accel's arrays must stay where they are.

@@ -186,7 +186,14 @@ ObjectLs object_line_space(const Accel& accel, const LsOptions& options, size_t 
   return ObjectLs{accel.spec.depth, accel.spec.subdivision};
 }
 
+namespace {
+std::atomic<size_t> layouts{0};
+}  // namespace
+
+size_t line_space_layouts() { return layouts.load(); }
+
 void layout_line_space_nodes(const LsOptions& options, const BvhSubtrees& subtrees, Accel& accel) {
+  ++layouts;
   accel.ls_options = options;
   // Every BVH's LS nodes, roots in node order: an object's own D and N (2L), or the structure's.
   std::vector<LsPlacement> placed;

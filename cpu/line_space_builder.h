@@ -108,4 +108,9 @@ size_t estimate_line_space_bytes(size_t ls_nodes, int n);
 
 size_t physical_memory_bytes();
 
+// How many Line Spaces layout_line_space_nodes() has laid out in this process (every CPU or GPU build,
+// and every 2l-ls:auto pilot evaluation, goes through it): the animation tests check that a
+// top-level update lays out none.
+size_t line_space_layouts();
+
 }  // namespace ls

@@ -43,7 +43,7 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
                             {"ls_nodes", accel.ls_info.ls_nodes},
                             {"shafts_per_ls", accel.ls_info.shafts_per_ls}});
   const BounceStats& primary = result.bounces.front();
-  return json{{"scene", context.scene},
+  json report{{"scene", context.scene},
               {"schedule", context.schedule},
               {"width", result.width},
               {"height", result.height},
@@ -61,6 +61,8 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
               {"per_bounce", per_bounce},
               {"structures", structures},
               {"dropped_samples", result.dropped_samples}};
+  if (!context.frame.is_null()) report["frame"] = context.frame;
+  return report;
 }
 
 nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context) {

@@ -3,7 +3,8 @@
 namespace ls::gpu {
 
 GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
-    : nodes_(make_buffer(context, accel.nodes, "nodes")),
+    : context_(&context),
+      nodes_(make_buffer(context, accel.nodes, "nodes")),
       tris_(make_buffer(context, accel.tris, "tris")),
       tri_ids_(make_buffer(context, accel.tri_ids, "tri_ids")),
       tri_instances_(make_buffer(context, accel.tri_instances, "tri_instances")),
@@ -25,6 +26,18 @@ std::vector<const Buffer*> GpuAccel::bindings() const {
 
 void GpuAccel::upload_candidates(const Accel& accel) {
   if (!accel.ls_candidates.empty()) ls_candidates_.upload(accel.ls_candidates.data(), accel.ls_candidates.size() * sizeof(uint32_t));
+}
+
+void GpuAccel::upload_top_level(const Accel& accel) {
+  // A rebuilt top level may hold more nodes than the buffer: then it gets a new one (bindings() hands
+  // out the member's address, which stays; pipelines bind per dispatch).
+  const auto refresh = [&](Buffer& buffer, const auto& values, const char* name) {
+    const size_t bytes = values.size() * sizeof(values[0]);
+    if (bytes > buffer.size()) buffer = make_buffer(*context_, values, name);
+    else if (bytes > 0) buffer.upload(values.data(), bytes);
+  };
+  refresh(top_nodes_, accel.top_nodes, "top_nodes");
+  refresh(instances_, accel.instances, "instances");
 }
 
 }  // namespace ls::gpu

@@ -18,10 +18,14 @@ class GpuAccel {
   std::vector<const Buffer*> bindings() const;
   // Copies accel.ls_candidates again (after a search filled them).
   void upload_candidates(const Accel& accel);
+  // Copies the top level again (top_nodes, instances) after update_top_level (render --frames): the
+  // object nodes, triangles and Line Space on the device are not touched.
+  void upload_top_level(const Accel& accel);
   // The parameters of lsk::TraceContext for this structure (ls_enabled, ls_cos2, two_level).
   ShaderParams params() const { return params_; }
 
  private:
+  const VulkanContext* context_;
   Buffer nodes_, tris_, tri_ids_, tri_instances_, top_nodes_, instances_, node_ls_, ls_nodes_, ls_candidates_, tri_normals_;
   ShaderParams params_;
 };

@@ -45,7 +45,8 @@ struct RayList {
 }  // namespace
 
 RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const std::map<std::string, Accel>& structures,
-                        const RenderOptions& options, const Progress& progress) {
+                        const RenderOptions& options, const Progress& progress,
+                        const std::map<const Accel*, const GpuAccel*>* resident) {
   const auto start = std::chrono::steady_clock::now();
   const uint32_t pixels = options.width * options.height;
   const int bounces = options.bounces;
@@ -65,9 +66,17 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     const std::string name = options.schedule.at(k).name();
     const auto it = structures.find(name);
     if (it == structures.end()) throw InputError("render: structure '" + name + "' was not built");
-    auto& up = uploaded[&it->second];
-    if (!up) up = std::make_unique<GpuAccel>(context, it->second);
-    accel[size_t(k)] = up.get();
+    const GpuAccel* on_device = nullptr;
+    if (resident) {
+      const auto r = resident->find(&it->second);
+      if (r != resident->end()) on_device = r->second;
+    }
+    if (!on_device) {
+      auto& up = uploaded[&it->second];
+      if (!up) up = std::make_unique<GpuAccel>(context, it->second);
+      on_device = up.get();
+    }
+    accel[size_t(k)] = on_device;
     line_space[size_t(k)] = it->second.spec.line_space();
     result.bounces[size_t(k)].structure = name;
   }

@@ -5,6 +5,7 @@
 // numbers and outputs as ls::render (cpu/path_tracer.h); on lavapipe the same images bit for bit.
 #pragma once
 
+#include "gpu_accel.h"
 #include "path_tracer.h"
 #include "vk_context.h"
 
@@ -13,8 +14,11 @@
 
 namespace ls::gpu {
 
+// resident: structures already on the device (render --frames keeps them between frames and refreshes
+// only their top level); the others are uploaded for this render.
 RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const std::map<std::string, Accel>& structures,
-                        const RenderOptions& options, const Progress& progress = {});
+                        const RenderOptions& options, const Progress& progress = {},
+                        const std::map<const Accel*, const GpuAccel*>* resident = nullptr);
 
 // build_schedule_structures() with the Line Space candidates searched on the GPU.
 std::map<std::string, Accel> build_schedule_structures_gpu(const VulkanContext& context, const Scene& scene,

@@ -11,6 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
 #include <cstdio>
 #include <iostream>
 
@@ -51,9 +54,26 @@ class GpuBackend : public Backend {
     if (timing_text) *timing_text = " in " + std::to_string(timing.kernel_seconds) + " s (kernel)";
     return hits;
   }
+  // Structures stay on the device between renders (render --frames): a new build is uploaded whole,
+  // an updated top level alone.
   RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
                       const Progress& progress) override {
-    return gpu::render_gpu(context_, scene, structures, options, progress);
+    std::map<const Accel*, const gpu::GpuAccel*> on_device;
+    for (const auto& entry : structures) on_device[&entry.second] = &resident(entry.second);
+    return gpu::render_gpu(context_, scene, structures, options, progress, &on_device);
+  }
+  // The top level is rebuilt on the host (as every BVH of the port), then only its nodes and instance
+  // records are copied to the device copy, if there is one yet.
+  TopLevelUpdate update_top_level(const Scene& posed, Accel& accel, TopLevelMode mode) override {
+    const auto start = std::chrono::steady_clock::now();
+    TopLevelUpdate update = Backend::update_top_level(posed, accel, mode);
+    const auto it = resident_.find(&accel);
+    if (it != resident_.end() && it->second.build_id == accel.build_id && accel.build_id != 0) {
+      it->second.gpu->upload_top_level(accel);
+      it->second.top_level_version = accel.top_level_version;
+    }
+    update.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return update;
   }
   // MRays/s from the median kernel time (timestamps; wall time where the queue has none).
   void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs, int repeats,
@@ -99,8 +119,28 @@ class GpuBackend : public Backend {
   }
 
  private:
+  struct Resident {
+    std::unique_ptr<gpu::GpuAccel> gpu;
+    uint64_t build_id = 0;
+    uint32_t top_level_version = 0;
+  };
+  // The device copy of `accel`, made or refreshed as its build id and top-level version say.
+  const gpu::GpuAccel& resident(const Accel& accel) {
+    Resident& r = resident_[&accel];
+    if (!r.gpu || accel.build_id == 0 || r.build_id != accel.build_id) {
+      r.gpu.reset();  // free the old copy first
+      r.gpu = std::make_unique<gpu::GpuAccel>(context_, accel);
+    } else if (r.top_level_version != accel.top_level_version) {
+      r.gpu->upload_top_level(accel);
+    }
+    r.build_id = accel.build_id;
+    r.top_level_version = accel.top_level_version;
+    return *r.gpu;
+  }
+
   gpu::VulkanContext context_;
   std::string device_;
+  std::map<const Accel*, Resident> resident_;
 };
 
 }  // namespace

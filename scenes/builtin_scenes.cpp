@@ -7,6 +7,12 @@
 //   instances          closed room [-7.5,7.5]x[0,6]x[-7.5,7.5] (6 wall objects), two ceiling lights, an
 //                      8x8 grid of 64 instances of ONE 51,200-triangle torus knot (own rotation and scale,
 //                      every fourth non-uniform) and three unique objects: 12 objects, 75 instances.
+//   carousel           rigid animation (issue 8): the instances room with one ceiling light, a pedestal and a
+//                      sphere (static, unique), 16 instances of one 12,800-triangle torus knot riding a
+//                      carousel (a hub node turning once in 4 s; each knot spinning, every other one bobbing)
+//                      and 8 instances of one 3,968-triangle ball pulsing in scale: 11 objects, 33 instances,
+//                      238,778 world triangles; the animation (4 s, looping) exercises LINEAR, STEP and
+//                      CUBICSPLINE channels of translation, rotation and scale.  Its still pose is t = 0.
 //   generated:T:O:S    O objects (ellipsoids; an object whose budget is under 6 triangles gets loose
 //                      triangles) holding exactly T triangles, seed S, each its own mesh and instance, PLUS
 //                      one emissive quad light above them: O+1 objects, O+1 instances, T+2 triangles.
@@ -15,6 +21,8 @@
 // Every object is built so that its triangles wind counter-clockwise seen from the side its vertex
 // normals point to (outwards for solids, into the room for walls).
 #include "load_scene.h"
+
+#include "animation.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -318,6 +326,147 @@ Scene instances() {
   return s;
 }
 
+// ---- carousel (rigid animation) ----
+
+// A rig node that places one instance with its current transform (static objects).
+void add_static_node(Scene& s, uint32_t instance) {
+  RigNode node;
+  node.has_matrix = true;
+  node.matrix = glm::dmat4(s.instances[instance].object_to_world);
+  node.instance = int(instance);
+  s.rig.order.push_back(uint32_t(s.rig.nodes.size()));
+  s.rig.nodes.push_back(node);
+}
+
+uint32_t add_rig_node(Scene& s, const RigNode& node) {
+  s.rig.order.push_back(uint32_t(s.rig.nodes.size()));
+  s.rig.nodes.push_back(node);
+  return uint32_t(s.rig.nodes.size() - 1);
+}
+
+// glTF order x, y, z, w: the rotation by `angle` about the unit `axis`.
+glm::vec4 axis_angle(const glm::dvec3& axis, double angle) {
+  const glm::dvec3 v = axis * std::sin(0.5 * angle);
+  return glm::vec4(float(v.x), float(v.y), float(v.z), float(std::cos(0.5 * angle)));
+}
+
+Scene carousel() {
+  Scene s;
+  const uint32_t walls = add_material(s, "walls", {0.75f, 0.75f, 0.72f});
+  const uint32_t floor = add_material(s, "floor", {0.55f, 0.55f, 0.55f});
+  const uint32_t ceiling = add_material(s, "ceiling", glm::vec3(0.8f));
+  const uint32_t light = add_material(s, "light", glm::vec3(0.78f), {18.0f, 17.0f, 15.0f});
+  const uint32_t knot = add_material(s, "knot", {0.8f, 0.45f, 0.2f});
+  const uint32_t ball = add_material(s, "ball", {0.25f, 0.4f, 0.75f});
+  const uint32_t stone = add_material(s, "pedestal", {0.6f, 0.58f, 0.55f});
+  const uint32_t red = add_material(s, "sphere", {0.7f, 0.2f, 0.25f});
+
+  const glm::vec3 lo(-7.5f, 0.0f, -7.5f), hi(7.5f, 6.0f, 7.5f);
+  add_room(s, lo, hi, {walls, walls, floor, ceiling, walls, walls});
+  add_ceiling_light(s, "light", 0.0f, 0.0f, 1.5f, 1.5f, hi.y - 2e-3f, light);
+  Mesh pedestal, sphere;
+  add_box(pedestal, {0.9f, 0.5f, 0.9f}, stone, glm::translate(glm::mat4(1.0f), {0.0f, 0.5f + kGap, 0.0f}));
+  add_object(s, std::move(pedestal), "pedestal");
+  add_ellipsoid(sphere, glm::vec3(0.7f), 24, 48, red, glm::translate(glm::mat4(1.0f), {0.0f, 1.7f + 2.0f * kGap, 0.0f}));
+  add_object(s, std::move(sphere), "sphere");
+  for (uint32_t i = 0; i < uint32_t(s.instances.size()); ++i) add_static_node(s, i);
+
+  s.meshes.push_back(torus_knot(160, 40, 0.5, knot));
+  const uint32_t knot_mesh = uint32_t(s.meshes.size() - 1);
+  Mesh ball_mesh;
+  add_ellipsoid(ball_mesh, glm::vec3(0.45f), 32, 64, ball);
+  ball_mesh.name = "ball";
+  s.meshes.push_back(std::move(ball_mesh));
+  const uint32_t ball_mesh_index = uint32_t(s.meshes.size() - 1);
+
+  const double pi = 3.14159265358979323846;
+  Animation anim;
+  anim.name = "carousel";
+  // Keys every 0.5 s (hub: 45 degrees apart, so every slerp takes the intended way round).
+  std::vector<float> half_seconds;
+  for (int k = 0; k <= 8; ++k) half_seconds.push_back(0.5f * float(k));
+
+  RigNode hub;
+  const uint32_t hub_node = add_rig_node(s, hub);
+  AnimationChannel turn;
+  turn.node = hub_node;
+  turn.path = AnimationPath::Rotation;
+  turn.times = half_seconds;
+  for (float t : half_seconds) turn.values.push_back(axis_angle({0.0, 1.0, 0.0}, -2.0 * pi * double(t) / 4.0));
+  anim.channels.push_back(turn);
+
+  // 16 knots on a ring of radius 5 around the hub, each spinning twice in 4 s about its own tilted
+  // axis; the even ones bob (a cubic spline through samples of a sine, its derivative as tangents).
+  for (int k = 0; k < 16; ++k) {
+    const double phi = 2.0 * pi * double(k) / 16.0;
+    Instance inst;
+    inst.mesh = knot_mesh;
+    inst.name = "knot " + std::to_string(k);
+    s.instances.push_back(inst);
+    RigNode node;
+    node.parent = int(hub_node);
+    node.translation = glm::dvec3(5.0 * std::cos(phi), 1.6, 5.0 * std::sin(phi));
+    node.scale = glm::dvec3(0.6);
+    node.instance = int(s.instances.size() - 1);
+    const uint32_t n = add_rig_node(s, node);
+    const glm::dvec3 axis = glm::normalize(glm::dvec3(std::cos(phi + 1.0), 2.0, std::sin(phi + 1.0)));
+    AnimationChannel spin;
+    spin.node = n;
+    spin.path = AnimationPath::Rotation;
+    for (int i = 0; i <= 16; ++i) {  // 45 degrees every 0.25 s
+      spin.times.push_back(0.25f * float(i));
+      spin.values.push_back(axis_angle(axis, phi + 0.25 * pi * double(i)));
+    }
+    anim.channels.push_back(spin);
+    if (k % 2 == 0) {
+      AnimationChannel bob;
+      bob.node = n;
+      bob.path = AnimationPath::Translation;
+      bob.interpolation = Interpolation::CubicSpline;
+      bob.times = half_seconds;
+      for (float t : half_seconds) {  // y = 1.6 + 0.5 sin(pi t + phi), period 2 s
+        const double a = pi * double(t) + phi;
+        const glm::vec4 tangent(0.0f, float(0.5 * pi * std::cos(a)), 0.0f, 0.0f);
+        bob.values.push_back(tangent);
+        bob.values.push_back(glm::vec4(glm::vec3(node.translation.x, 1.6 + 0.5 * std::sin(a), node.translation.z), 0.0f));
+        bob.values.push_back(tangent);
+      }
+      anim.channels.push_back(bob);
+    }
+  }
+  // 8 balls on an inner ring, pulsing in scale once a second: LINEAR (even) and STEP (odd).
+  for (int j = 0; j < 8; ++j) {
+    const double phi = 2.0 * pi * (double(j) + 0.5) / 8.0;
+    Instance inst;
+    inst.mesh = ball_mesh_index;
+    inst.name = "ball " + std::to_string(j);
+    s.instances.push_back(inst);
+    RigNode node;
+    node.translation = glm::dvec3(2.6 * std::cos(phi), 0.62, 2.6 * std::sin(phi));
+    node.instance = int(s.instances.size() - 1);
+    AnimationChannel pulse;
+    pulse.node = add_rig_node(s, node);
+    pulse.path = AnimationPath::Scale;
+    pulse.interpolation = j % 2 == 0 ? Interpolation::Linear : Interpolation::Step;
+    for (int i = 0; i <= 8; ++i) {
+      pulse.times.push_back(0.5f * float(i));
+      const float scale = (i + j) % 2 == 0 ? 0.7f : 1.3f;
+      pulse.values.push_back(glm::vec4(scale, scale, scale, 0.0f));
+    }
+    anim.channels.push_back(pulse);
+  }
+  s.rig.animations.push_back(std::move(anim));
+
+  s.camera.position = {0.0f, 4.2f, 7.3f};
+  s.camera.target = {0.0f, 1.2f, -0.5f};
+  s.camera.up = {0.0f, 1.0f, 0.0f};
+  s.camera.yfov = 1.0f;
+  s.background = glm::vec3(0.0f);
+  s.name = "builtin:carousel";
+  pose_scene(s, 0.0);  // the still pose: t = 0
+  return s;
+}
+
 // ---- generated:T:O:S ----
 
 // A strictly parsed decimal number: digits only, no sign, no spaces, no overflow.
@@ -424,10 +573,12 @@ Scene builtin_scene(const std::string& name_in) {
     s = cornell();
   } else if (name == "instances") {
     s = instances();
+  } else if (name == "carousel") {
+    s = carousel();
   } else if (name == "generated" || name.compare(0, 10, "generated:") == 0) {
     s = generated(name, name.size() > 9 ? std::optional<std::string>(name.substr(10)) : std::nullopt);
   } else {
-    throw InputError("builtin:" + name + ": unknown built-in scene (known: cornell, instances, generated[:T[:O[:S]]])");
+    throw InputError("builtin:" + name + ": unknown built-in scene (known: cornell, instances, carousel, generated[:T[:O[:S]]])");
   }
   s.name = prefix + name;
   validate_scene(s);

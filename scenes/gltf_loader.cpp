@@ -18,6 +18,8 @@
 #include <filesystem>
 #include <new>
 #include <optional>
+#include <set>
+#include <utility>
 
 namespace ls {
 
@@ -73,6 +75,7 @@ class GltfReader {
       scene.materials.push_back(grey);
     }
     read_nodes(scene);
+    read_animations(scene);
     return scene;
   }
 
@@ -271,11 +274,138 @@ class GltfReader {
     return mesh;
   }
 
+  // ---- animations (common/animation.h) ----
+
+  // Key times: float, finite, >= 0, strictly increasing (glTF 2.0, animation.sampler.input).
+  std::vector<float> read_times(int index, const std::string& where) const {
+    const View v = view(index, where + " input", TINYGLTF_TYPE_SCALAR, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+    if (v.count == 0) fail(where + ": no keyframes");
+    std::vector<float> times(v.count);
+    for (size_t i = 0; i < v.count; ++i) {
+      std::memcpy(&times[i], v.base + i * v.stride, sizeof(float));
+      if (!std::isfinite(times[i])) fail(where + ": key time " + std::to_string(i) + " is NaN or infinite");
+      if (i == 0 && times[i] < 0.0f) fail(where + ": the first key time is negative");
+      if (i > 0 && !(times[i] > times[i - 1]))
+        fail(where + ": key times are not strictly increasing (key " + std::to_string(i) + ")");
+    }
+    return times;
+  }
+
+  // Output values: translation and scale as float VEC3; rotation as float VEC4 or a normalized
+  // (signed or unsigned) byte or short VEC4, decoded as the glTF specification says.
+  std::vector<glm::vec4> read_values(int index, AnimationPath path, const std::string& where) const {
+    const std::string what = where + " output";
+    std::vector<glm::vec4> out;
+    if (path != AnimationPath::Rotation) {
+      const View v = view(index, what, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+      out.resize(v.count);
+      for (size_t i = 0; i < v.count; ++i) {
+        glm::vec3 x;
+        std::memcpy(&x, v.base + i * v.stride, sizeof(x));
+        out[i] = glm::vec4(x, 0.0f);
+      }
+    } else {
+      const View v = view(index, what, TINYGLTF_TYPE_VEC4,
+                          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                           TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+      if (v.component != TINYGLTF_COMPONENT_TYPE_FLOAT && !model_.accessors[size_t(index)].normalized)
+        fail(what + " accessor " + std::to_string(index) + " holds integer rotations that are not normalized");
+      out.resize(v.count);
+      for (size_t i = 0; i < v.count; ++i)
+        for (int c = 0; c < 4; ++c) {
+          const unsigned char* p = v.base + i * v.stride;
+          float& x = out[i][c];
+          if (v.component == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+            std::memcpy(&x, p + 4 * c, 4);
+          } else if (v.component == TINYGLTF_COMPONENT_TYPE_BYTE) {
+            x = std::max(float(int8_t(p[c])) / 127.0f, -1.0f);
+          } else if (v.component == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
+            x = float(p[c]) / 255.0f;
+          } else if (v.component == TINYGLTF_COMPONENT_TYPE_SHORT) {
+            int16_t h;
+            std::memcpy(&h, p + 2 * c, 2);
+            x = std::max(float(h) / 32767.0f, -1.0f);
+          } else {
+            uint16_t h;
+            std::memcpy(&h, p + 2 * c, 2);
+            x = float(h) / 65535.0f;
+          }
+        }
+    }
+    for (size_t i = 0; i < out.size(); ++i)
+      for (int c = 0; c < 4; ++c)
+        if (!std::isfinite(out[i][c])) fail(what + " value " + std::to_string(i) + " is NaN or infinite");
+    return out;
+  }
+
+  void read_animations(Scene& scene) const {
+    for (size_t ai = 0; ai < model_.animations.size(); ++ai) {
+      const tinygltf::Animation& ga = model_.animations[ai];
+      const std::string where = "animation " + std::to_string(ai);
+      Animation animation;
+      animation.name = ga.name;
+      std::set<std::pair<int, AnimationPath>> targeted;
+      for (size_t ci = 0; ci < ga.channels.size(); ++ci) {
+        const tinygltf::AnimationChannel& ch = ga.channels[ci];
+        const std::string cw = where + " channel " + std::to_string(ci);
+        if (ch.sampler < 0 || size_t(ch.sampler) >= ga.samplers.size())
+          fail(cw + ": sampler " + std::to_string(ch.sampler) + " does not exist");
+        const tinygltf::AnimationSampler& sampler = ga.samplers[size_t(ch.sampler)];
+        AnimationChannel c;
+        if (sampler.interpolation == "LINEAR") c.interpolation = Interpolation::Linear;
+        else if (sampler.interpolation == "STEP") c.interpolation = Interpolation::Step;
+        else if (sampler.interpolation == "CUBICSPLINE") c.interpolation = Interpolation::CubicSpline;
+        else fail(cw + ": unknown interpolation '" + sampler.interpolation.substr(0, 40) + "'");
+        const bool weights = ch.target_path == "weights";
+        if (ch.target_path == "translation") c.path = AnimationPath::Translation;
+        else if (ch.target_path == "rotation") c.path = AnimationPath::Rotation;
+        else if (ch.target_path == "scale") c.path = AnimationPath::Scale;
+        else if (!weights) fail(cw + ": unknown target path '" + ch.target_path.substr(0, 40) + "'");
+        if (ch.target_node < 0) continue;  // no node: the channel targets something of an extension
+        if (size_t(ch.target_node) >= model_.nodes.size())
+          fail(cw + ": node " + std::to_string(ch.target_node) + " does not exist");
+        c.node = uint32_t(ch.target_node);
+        c.times = read_times(sampler.input, cw);
+        const size_t per_key = c.interpolation == Interpolation::CubicSpline ? 3 : 1;
+        const size_t expected = c.times.size() * per_key;
+        if (weights) {  // not rigid: checked for size, counted, never posed
+          const View v = view(sampler.output, cw + " output", TINYGLTF_TYPE_SCALAR,
+                              {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                               TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+          if (v.count == 0 || v.count % expected != 0)
+            fail(cw + ": " + std::to_string(v.count) + " weights do not fit " + std::to_string(c.times.size()) + " keys");
+          ++animation.weight_channels;
+          continue;
+        }
+        if (!targeted.insert({ch.target_node, c.path}).second)
+          fail(cw + ": node " + std::to_string(ch.target_node) + " already has a " + ch.target_path + " channel");
+        if (!model_.nodes[c.node].matrix.empty())
+          fail(cw + ": node " + std::to_string(c.node) + " has a matrix, which glTF does not allow on animated nodes");
+        c.values = read_values(sampler.output, c.path, cw);
+        if (c.values.size() != expected)
+          fail(cw + ": " + std::to_string(c.values.size()) + " output values for " + std::to_string(c.times.size()) +
+               " keys (expected " + std::to_string(expected) + ")");
+        if (c.path == AnimationPath::Rotation)
+          for (size_t k = 0; k < c.times.size(); ++k) {  // the values (tangents may be anything finite)
+            glm::vec4& q = c.values[k * per_key + per_key / 2];
+            const double len = glm::length(glm::dvec4(q));
+            if (!(len > 0.0)) fail(cw + ": key " + std::to_string(k) + " is a quaternion of zero length");
+            q = glm::vec4(glm::dvec4(q) / len);
+          }
+        if (state_[c.node] != kDone) continue;  // outside the default scene: moves nothing
+        animation.channels.push_back(std::move(c));
+      }
+      scene.rig.animations.push_back(std::move(animation));
+    }
+  }
+
   // ---- nodes ----
 
-  glm::dmat4 local_transform(size_t n) const {
+  // A node's rest transform as posing needs it (animation.h); local_matrix() composes it.
+  RigNode rig_node(size_t n) const {
     const tinygltf::Node& node = model_.nodes[n];
     const std::string where = "node " + std::to_string(n);
+    RigNode rig;
     if (!node.matrix.empty()) {
       if (node.matrix.size() != 16) fail(where + ": matrix needs 16 numbers");
       glm::dmat4 m;
@@ -284,12 +414,13 @@ class GltfReader {
       // Instances are affine: a projective bottom row would be silently ignored by every transform.
       if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
         fail(where + ": matrix is not affine (bottom row must be 0 0 0 1)");
-      return m;
+      rig.has_matrix = true;
+      rig.matrix = m;
+      return rig;
     }
-    glm::dmat4 t(1.0), r(1.0), s(1.0);
     if (!node.translation.empty()) {
       if (node.translation.size() != 3) fail(where + ": translation needs 3 numbers");
-      t = glm::translate(glm::dmat4(1.0), glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+      rig.translation = glm::dvec3(node.translation[0], node.translation[1], node.translation[2]);
     }
     if (!node.rotation.empty()) {
       if (node.rotation.size() != 4) fail(where + ": rotation needs 4 numbers");
@@ -297,25 +428,29 @@ class GltfReader {
       glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
       const double len = glm::length(q);
       if (!(len > 0.0) || !std::isfinite(len)) fail(where + ": rotation is not a valid quaternion");
-      r = glm::mat4_cast(q / len);
+      rig.rotation = q / len;
     }
     if (!node.scale.empty()) {
       if (node.scale.size() != 3) fail(where + ": scale needs 3 numbers");
-      s = glm::scale(glm::dmat4(1.0), glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+      rig.scale = glm::dvec3(node.scale[0], node.scale[1], node.scale[2]);
     }
-    return t * r * s;
+    return rig;
   }
 
   // Depth-first from the roots; a node met again is a cycle (on the current path) or a second parent.
-  void visit(int n, const glm::dmat4& parent, int depth) {
+  void visit(int n, const glm::dmat4& parent, int parent_node, int depth) {
     if (n < 0 || size_t(n) >= model_.nodes.size()) fail("node " + std::to_string(n) + " does not exist");
     if (depth > kMaxDepth) fail("node hierarchy deeper than " + std::to_string(kMaxDepth));
     if (state_[size_t(n)] == kOnPath) fail("node " + std::to_string(n) + " is its own ancestor (cycle)");
     if (state_[size_t(n)] == kDone)
       fail("node " + std::to_string(n) + " is reached twice (glTF nodes must form a tree)");
     state_[size_t(n)] = kOnPath;
-    world_[size_t(n)] = parent * local_transform(size_t(n));
-    for (int child : model_.nodes[size_t(n)].children) visit(child, world_[size_t(n)], depth + 1);
+    RigNode& node = rig_[size_t(n)];
+    node = rig_node(size_t(n));
+    node.parent = parent_node;
+    order_.push_back(uint32_t(n));
+    world_[size_t(n)] = parent * local_matrix(node);
+    for (int child : model_.nodes[size_t(n)].children) visit(child, world_[size_t(n)], n, depth + 1);
     state_[size_t(n)] = kDone;
   }
 
@@ -339,7 +474,8 @@ class GltfReader {
   void read_nodes(Scene& scene) {
     state_.assign(model_.nodes.size(), kUnseen);
     world_.assign(model_.nodes.size(), glm::dmat4(1.0));
-    for (int root : roots()) visit(root, glm::dmat4(1.0), 0);
+    rig_.assign(model_.nodes.size(), RigNode{});
+    for (int root : roots()) visit(root, glm::dmat4(1.0), -1, 0);
 
     // Instance id = rank by node index of the reached mesh-bearing nodes (DESIGN §9).
     std::optional<size_t> camera_node;
@@ -349,6 +485,7 @@ class GltfReader {
       if (node.mesh >= 0) {
         if (size_t(node.mesh) >= model_.meshes.size())
           fail("node " + std::to_string(n) + ": mesh " + std::to_string(node.mesh) + " does not exist");
+        rig_[n].instance = int(scene.instances.size());
         Instance inst;
         inst.mesh = uint32_t(node.mesh);
         inst.object_to_world = glm::mat4(world_[n]);
@@ -363,23 +500,16 @@ class GltfReader {
     }
 
     if (camera_node) {
-      const glm::dmat4& m = world_[*camera_node];
       const double yfov = model_.cameras[size_t(model_.nodes[*camera_node].camera)].perspective.yfov;
       if (!(yfov > 0.0 && yfov < 3.14159)) fail("camera yfov " + std::to_string(yfov) + " is not in (0, pi)");
-      const glm::vec3 position(m * glm::dvec4(0.0, 0.0, 0.0, 1.0));
-      const auto forward = unit(glm::vec3(m * glm::dvec4(0.0, 0.0, -1.0, 0.0)));  // glTF cameras look down -Z
-      const auto up = unit(glm::vec3(m * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
-      if (!finite(position) || !forward || !up)
+      if (!camera_from_node(world_[*camera_node], yfov, scene.camera))
         fail("camera node " + std::to_string(*camera_node) + " has a degenerate transform");
-      scene.camera.position = position;
-      // One unit ahead vanishes into the rounding of a position 1e30 away: look as far ahead as the
-      // position is from the origin.
-      const float reach = std::max({1.0f, std::fabs(position.x), std::fabs(position.y), std::fabs(position.z)});
-      scene.camera.target = position + *forward * reach;
-      scene.camera.up = *up;
-      scene.camera.yfov = float(yfov);
       has_camera_ = true;
+      scene.rig.camera_node = int(*camera_node);
+      scene.rig.camera_yfov = yfov;
     }
+    scene.rig.nodes = std::move(rig_);
+    scene.rig.order = std::move(order_);
   }
 
   enum : uint8_t { kUnseen, kOnPath, kDone };
@@ -389,6 +519,8 @@ class GltfReader {
   bool has_camera_ = false;
   std::vector<uint8_t> state_;
   std::vector<glm::dmat4> world_;
+  std::vector<RigNode> rig_;
+  std::vector<uint32_t> order_;  // visit order: parents before children
 };
 
 }  // namespace

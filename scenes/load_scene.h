@@ -14,7 +14,9 @@ Scene load_scene(const std::string& spec);
 
 // glTF 2.0 (.gltf or .glb): meshes are objects, mesh-bearing nodes of the default scene are instances
 // (ordered by node index), baseColorFactor is the albedo, emissiveFactor makes an area light, the
-// first perspective camera is the view (else a framing camera).
+// first perspective camera is the view (else a framing camera).  The node hierarchy and every
+// animation of node transforms are kept in Scene::rig for posing (common/animation.h); the scene
+// itself is in its rest pose.
 Scene load_gltf(const std::string& path);
 
 // The same from bytes already in memory (fuzzing, tests): `name` only labels messages.  binary picks
@@ -33,6 +35,8 @@ Scene load_mesh_bytes(const std::string& bytes, const std::string& format, const
 // Built-in, deterministic scenes (no files):
 //   builtin:cornell                  closed room, several objects, one area light (the default scene)
 //   builtin:instances                room with 64 instances of one 51,200-triangle mesh + unique objects
+//   builtin:carousel                 animated (common/animation.h): 24 instances of two meshes riding,
+//                                    spinning, bobbing and pulsing, plus static unique objects
 //   builtin:generated:T:O:S          T triangles spread over O objects, seed S (scaling studies)
 Scene builtin_scene(const std::string& name);
 

@@ -50,6 +50,17 @@ struct Gltf {
     return accessor(R"({"bufferView":)" + std::to_string(bv) + R"(,"componentType":5126,"count":)" +
                     std::to_string(v.size()) + R"(,"type":"VEC3"})");
   }
+  // Float SCALARs (animation key times, weights).
+  int scalars(const std::vector<float>& v) {
+    const int bv = view(v.data(), v.size() * sizeof(float));
+    return accessor(R"({"bufferView":)" + std::to_string(bv) + R"(,"componentType":5126,"count":)" +
+                    std::to_string(v.size()) + R"(,"type":"SCALAR"})");
+  }
+  int vec4(const std::vector<glm::vec4>& v) {
+    const int bv = view(v.data(), v.size() * sizeof(glm::vec4));
+    return accessor(R"({"bufferView":)" + std::to_string(bv) + R"(,"componentType":5126,"count":)" +
+                    std::to_string(v.size()) + R"(,"type":"VEC4"})");
+  }
   template <typename T>
   int indices(const std::vector<T>& idx) {
     const int type = sizeof(T) == 1 ? 5121 : sizeof(T) == 2 ? 5123 : 5125;
@@ -86,6 +97,17 @@ struct Gltf {
     return out;
   }
 };
+
+// One animation channel with its own sampler, as the JSON of `"channels"` and `"samplers"` entries:
+// channel_json(sampler index, node, path) and sampler_json(input, output, interpolation).
+inline std::string channel_json(int sampler, int node, const std::string& path) {
+  return R"({"sampler":)" + std::to_string(sampler) + R"(,"target":{"node":)" + std::to_string(node) + R"(,"path":")" +
+         path + "\"}}";
+}
+inline std::string sampler_json(int input, int output, const std::string& interpolation) {
+  return R"({"input":)" + std::to_string(input) + R"(,"output":)" + std::to_string(output) + R"(,"interpolation":")" +
+         interpolation + "\"}";
+}
 
 inline const std::vector<glm::vec3> kTriangle = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
 

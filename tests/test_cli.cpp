@@ -290,3 +290,185 @@ TEST_CASE("hostile scenes through linespace-cpu: exit 2 with one line, or a fini
   std::ifstream f(temp("dark") / "report.json");
   CHECK(nlohmann::json::parse(f)["dropped_samples"].get<long>() == 0);
 }
+
+namespace {
+
+// An animated glTF for `render --frames`: a static emissive quad lighting a white triangle (node 1)
+// that slides along x, LINEAR over 1 s.  extra_channels: more channels on node 1 (sampler 0's keys).
+std::string animated_gltf(const std::string& extra_channels = "", const std::string& extra_animations = "") {
+  using namespace ls_test;
+  Gltf g;
+  const int quad = g.vec3({{-2, 2, -1}, {2, 2, -1}, {2, 2, 1}, {-2, 2, -1}, {2, 2, 1}, {-2, 2, 1}});
+  const int tri = g.vec3({{-0.5f, 0, -0.5f}, {0.5f, 0, -0.5f}, {0, 0, 0.5f}});
+  const int times = g.scalars({0.0f, 1.0f});
+  const int moves = g.vec3({{-1, 0, 0}, {1, 0, 0}});
+  return g.json(R"("materials":[{"emissiveFactor":[4,4,4]},{}],"meshes":[{"primitives":[{"attributes":{"POSITION":)" +
+                std::to_string(quad) + R"(},"material":0}]},{"primitives":[{"attributes":{"POSITION":)" + std::to_string(tri) +
+                R"(},"material":1}]}],"nodes":[{"mesh":0},{"mesh":1},{"camera":0,"translation":[0,1,4]}],)"
+                R"("cameras":[{"type":"perspective","perspective":{"yfov":1.0,"znear":0.1}}],)"
+                R"("animations":[{"name":"slide","channels":[)" + channel_json(0, 1, "translation") + extra_channels +
+                R"(],"samplers":[)" + sampler_json(times, moves, "LINEAR") + "]}" + extra_animations + "]");
+}
+
+}  // namespace
+
+TEST_CASE("render --frames writes one folder per frame and frames.json with the documented keys", "[cli][animation]") {
+  using nlohmann::json;
+  fs::create_directories(temp(""));
+  write_text(temp("slide.gltf"), animated_gltf());
+  const fs::path out = temp("frames");
+  fs::remove_all(out);
+  const Run r = run("render --scene " + temp("slide.gltf").string() + " --schedule bvh,2l-bvh,2l-ls:1:2 --spp 1 --bounces 1 " +
+                    "--size 24x16 --frames 2:4 --fps 4 --out " + out.string());
+  INFO(r.out << r.err);
+  REQUIRE(r.status == 0);
+  std::vector<std::string> pngs;
+  for (int f = 2; f <= 4; ++f) {
+    const fs::path dir = out / ("frame_000" + std::to_string(f));
+    for (const char* file : {"total.exr", "bounce_0.exr", "bounce_1.exr", "image.png", "report.json"}) CHECK(fs::exists(dir / file));
+    std::ifstream rf(dir / "report.json");
+    const json report = json::parse(rf);
+    CHECK(report["frame"]["frame"] == f);
+    CHECK(report["per_bounce"].size() == 2);
+    pngs.push_back(slurp(dir / "image.png"));
+  }
+  CHECK(pngs[0] != pngs[1]);  // the triangle moved
+  CHECK(pngs[1] != pngs[2]);
+  for (const auto& entry : fs::recursive_directory_iterator(out)) CHECK(entry.path().string().find(".partial") == std::string::npos);
+
+  std::ifstream f(out / "frames.json");
+  const json j = json::parse(f);
+  for (const char* key : {"scene", "animation", "schedule", "width", "height", "spp", "bounces", "seed", "fps", "first_frame",
+                          "last_frame", "top_level_update", "flat_comparison", "device", "threads", "initial_build", "frames",
+                          "frames_done", "complete", "summary"})
+    CHECK(j.contains(key));
+  CHECK(j["animation"]["name"] == "slide");
+  CHECK(j["animation"]["duration"] == 1.0);
+  CHECK(j["complete"] == true);
+  CHECK(j["frames_done"] == 3);
+  CHECK(j["top_level_update"] == "rebuild");
+  CHECK(j["initial_build"].size() == 2);  // 2l-bvh and 2l-ls:1:2, once
+  REQUIRE(j["frames"].size() == 3);
+  for (size_t i = 0; i < 3; ++i) {
+    const json& fr = j["frames"][i];
+    CHECK(fr["frame"] == int(i) + 2);
+    CHECK(fr["time"].get<double>() == (double(i) + 2.0) / 4.0);
+    CHECK(fr["dir"] == "frame_000" + std::to_string(i + 2));
+    for (const char* key : {"render_seconds", "indirect_rays", "indirect_seconds", "indirect_mrays_per_s"}) CHECK(fr.contains(key));
+    REQUIRE(fr["updates"].size() == 3);
+    CHECK(fr["updates"][0]["structure"] == "bvh");
+    CHECK(fr["updates"][0]["update"] == "rebuild");
+    CHECK_FALSE(fr["updates"][0].contains("flat_structure"));
+    CHECK(fr["updates"][1]["update"] == "top-level");
+    CHECK(fr["updates"][1]["flat_structure"] == "bvh");
+    // 2l-bvh's comparison is the schedule's own bvh rebuild of this frame
+    CHECK(fr["updates"][1]["flat_rebuild_seconds"] == fr["updates"][0]["seconds"]);
+    CHECK(fr["updates"][2]["flat_structure"] == "f-ls:1:2");
+    for (const json& u : fr["updates"]) CHECK(u["seconds"].get<double>() > 0.0);
+    CHECK(fr["updates"][2]["flat_rebuild_seconds"].get<double>() > 0.0);
+    CHECK(fr["updates"][2].contains("flat_over_update"));
+  }
+  REQUIRE(j["summary"].size() == 3);
+  CHECK(j["summary"][2]["flat_structure"] == "f-ls:1:2");
+  CHECK(j["summary"][2].contains("median_flat_rebuild_seconds"));
+  // A line per frame on stderr, a header and a row per frame on stdout.
+  CHECK(line_count(r.err) == 3);
+  CHECK(r.out.find("2l-ls:1:2 top ms") != std::string::npos);
+  CHECK(r.out.find("median per frame: 2l-ls:1:2 top-level") != std::string::npos);
+
+  // --no-flat-comparison and a refitted top level; a still render of the animated file notes it.
+  const Run q = run("render --scene " + temp("slide.gltf").string() + " --schedule 2l-ls:1:2 --spp 1 --bounces 0 --size 8x8 " +
+                    "--frames 0:1 --no-flat-comparison --top-level-update refit --quiet --out " + temp("frames_q").string());
+  INFO(q.err);
+  REQUIRE(q.status == 0);
+  CHECK(q.err.empty());
+  std::ifstream fq(temp("frames_q") / "frames.json");
+  const json jq = json::parse(fq);
+  CHECK(jq["top_level_update"] == "refit");
+  CHECK_FALSE(jq["frames"][0]["updates"][0].contains("flat_structure"));
+  const Run still = run("render --scene " + temp("slide.gltf").string() + " --spp 1 --size 8x8 --quiet --out " + temp("still").string());
+  CHECK(still.status == 0);
+  CHECK(still.err.find("note: ") == 0);
+}
+
+TEST_CASE("render --frames on a scene without animation renders the same pose with a note", "[cli][animation]") {
+  const fs::path out = temp("static_frames");
+  fs::remove_all(out);
+  const Run r = run("render --scene builtin:cornell --schedule 2l-bvh --spp 1 --bounces 1 --size 16x16 --frames 0:1 --quiet "
+                    "--no-flat-comparison --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.err.find("has no animation") != std::string::npos);
+  CHECK(slurp(out / "frame_0000" / "image.png") == slurp(out / "frame_0001" / "image.png"));
+}
+
+TEST_CASE("render --frames: bad ranges, rates and animations exit 2 with a one-line reason", "[cli][animation]") {
+  using namespace ls_test;
+  fs::create_directories(temp(""));
+  write_text(temp("slide2.gltf"), animated_gltf());
+  {
+    Gltf g;  // a weights channel: not rigid
+    const int pos = g.vec3(kTriangle), times = g.scalars({0.0f, 1.0f}), w = g.scalars({0.0f, 1.0f});
+    write_text(temp("weights.gltf"), g.json(R"("materials":[{"emissiveFactor":[1,1,1]}],"meshes":[{"primitives":[{"attributes":{"POSITION":)" +
+                                                std::to_string(pos) + R"(},"material":0}]}],"nodes":[{"mesh":0}],"animations":[{"channels":[)" +
+                                                channel_json(0, 0, "weights") + R"(],"samplers":[)" + sampler_json(times, w, "LINEAR") + "]}]"));
+  }
+  {
+    Gltf g;  // a scale key of 0 at 1 s: the pose of frame 24 is singular
+    const int pos = g.vec3(kTriangle), times = g.scalars({0.0f, 1.0f}), s = g.vec3({{1, 1, 1}, {0, 1, 1}});
+    write_text(temp("flatten.gltf"), g.json(R"("materials":[{"emissiveFactor":[1,1,1]}],"meshes":[{"primitives":[{"attributes":{"POSITION":)" +
+                                                std::to_string(pos) + R"(},"material":0}]}],"nodes":[{"mesh":0}],"animations":[{"channels":[)" +
+                                                channel_json(0, 0, "scale") + R"(],"samplers":[)" + sampler_json(times, s, "STEP") + "]}]"));
+  }
+  const std::string scene = " --scene " + temp("slide2.gltf").string() + " --size 8x8 --spp 1 --out " + temp("bad_frames").string();
+  const std::vector<std::string> cases = {
+      "render --frames 5:2" + scene,
+      "render --frames -1:3" + scene,
+      "render --frames a:b" + scene,
+      "render --frames 1:2:3" + scene,
+      "render --frames 0:10000" + scene,
+      "render --frames 99999999" + scene,
+      "render --frames 0:1 --fps 0" + scene,
+      "render --frames 0:1 --fps 1e9" + scene,
+      "render --fps 30" + scene,
+      "render --frames 0:1 --animation 1" + scene,
+      "render --frames 0:1 --top-level-update sideways" + scene,
+      "render --frames 0:1 --scene " + temp("weights.gltf").string() + " --size 8x8 --out " + temp("bad_frames").string(),
+      "render --frames 0:30 --scene " + temp("flatten.gltf").string() + " --size 8x8 --out " + temp("bad_frames").string(),
+      "render --frames 0:1 --animation 2 --scene builtin:cornell --size 8x8 --out " + temp("bad_frames").string(),
+  };
+  for (const std::string& args : cases) {
+    const Run r = run(args);
+    INFO(args << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.rfind("linespace-cpu: ", 0) == 0);
+  }
+  CHECK(!fs::exists(temp("bad_frames")));
+}
+
+TEST_CASE("SIGINT during render --frames exits 130 leaving only whole frames and a frames.json that lists them", "[cli][animation]") {
+  fs::create_directories(temp(""));
+  const fs::path out = temp("interrupted_frames"), err = temp("frames_interrupt.err");
+  fs::remove_all(out);
+  const int status = run_and_signal({"render", "--scene", "builtin:cornell", "--schedule", "2l-bvh", "--size", "64x64", "--spp", "512",
+                                     "--bounces", "1", "--frames", "0:1000", "--no-flat-comparison", "--out", out.string()},
+                                    err.string(), SIGINT, 2.0);
+  INFO("stderr: " << slurp(err));
+  CHECK(status == 130);
+  size_t frames = 0;
+  if (fs::exists(out))
+    for (const auto& entry : fs::recursive_directory_iterator(out)) {
+      CHECK(entry.path().string().find(".partial") == std::string::npos);
+      if (entry.is_directory()) {
+        ++frames;
+        CHECK(fs::exists(entry.path() / "report.json"));
+      }
+    }
+  if (frames > 0) {
+    std::ifstream f(out / "frames.json");
+    const auto j = nlohmann::json::parse(f);
+    CHECK(j["complete"] == false);
+    CHECK(j["frames_done"].get<size_t>() == frames);
+  }
+}

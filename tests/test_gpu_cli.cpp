@@ -1,9 +1,12 @@
 // linespace-gpu end to end: bad input exits 2 with a one-line reason (no device or a wrong --device
 // included), and its hit files, build report and render equal linespace-cpu's.
+#include "image_output.h"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -140,4 +143,27 @@ TEST_CASE("linespace-validate rmse on the GPU gives the CPU's RMSE", "[gpu_cli]"
     CHECK(cpu[i].at("structure") == gpu[i].at("structure"));
     CHECK(cpu[i].at("rmse") == gpu[i].at("rmse"));  // the same images, so exactly the same error
   }
+}
+
+TEST_CASE("linespace-gpu render --frames writes the frames linespace-cpu writes, pixel for pixel", "[gpu_cli][animation]") {
+  const std::string args = "render --scene builtin:carousel --schedule 2l-bvh,2l-ls:1:2 --size 20x14 --spp 1 --bounces 2 "
+                           "--frames 10:12 --no-flat-comparison --quiet --out ";
+  const Run c = run(LINESPACE_CPU, args + temp("frames_cpu").string());
+  const Run g = run(LINESPACE_GPU, args + temp("frames_gpu").string());
+  INFO(c.err << g.err);
+  REQUIRE(c.status == 0);
+  REQUIRE(g.status == 0);
+  for (int f = 10; f <= 12; ++f)
+    for (const char* file : {"total.exr", "bounce_0.exr", "bounce_1.exr", "bounce_2.exr"}) {
+      const std::string rel = "/frame_00" + std::to_string(f) + "/" + file;
+      INFO(rel);
+      const ls::Image a = ls::read_image(temp("frames_cpu").string() + rel), b = ls::read_image(temp("frames_gpu").string() + rel);
+      REQUIRE(a.pixels.size() == 20u * 14u);
+      REQUIRE(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)) == 0);
+    }
+  const auto jc = nlohmann::json::parse(slurp(temp("frames_cpu") / "frames.json"));
+  const auto jg = nlohmann::json::parse(slurp(temp("frames_gpu") / "frames.json"));
+  CHECK(jg["frames_done"] == 3);
+  CHECK(jg["device"] != jc["device"]);
+  for (size_t i = 0; i < 3; ++i) CHECK(jg["frames"][i]["indirect_rays"] == jc["frames"][i]["indirect_rays"]);
 }
