@@ -210,11 +210,12 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
 }
 
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
-                lsk::LsCounters* counters, Traversal traversal) {
+                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
   const lsk::TraceContext context = accel.context();
   const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
   // Per-thread counters, summed once at the end: no lock on the hot path.
   tbb::enumerable_thread_specific<lsk::LsCounters> per_thread(lsk::LsCounters{});
+  tbb::enumerable_thread_specific<TraceWorkTotals> per_thread_work;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
     lsk::TraceContext local = context;
     if (fast)
@@ -222,9 +223,21 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
     else
       for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray_counted(local, accel, rays[i], any_hit);
     if (counters && accel.spec.line_space()) add_counters(per_thread.local(), local.ls_counters);
+    if (work) {
+      TraceWorkTotals& w = per_thread_work.local();
+      w.box_tests += local.trace_work.box_tests;
+      w.triangle_tests += local.trace_work.triangle_tests;
+      w.lookups += local.ls_counters.lookups;
+    }
   });
   if (counters)
     for (const lsk::LsCounters& c : per_thread) add_counters(*counters, c);
+  if (work)
+    for (const TraceWorkTotals& w : per_thread_work) {
+      work->box_tests += w.box_tests;
+      work->triangle_tests += w.triangle_tests;
+      work->lookups += w.lookups;
+    }
 }
 
 }  // namespace ls

@@ -80,8 +80,14 @@ lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const
 // when given.  The second form names the traversal (bench and tests run both on one structure).
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters = nullptr);
+// The reference traversal's work over a batch (the 2l-ls:auto pilot's model, ls_budget.h): box and
+// triangle tests counted by the kernels, Line Space lookups by the counters.  The fast path counts its
+// triangle tests only (its box tests are SIMD lanes the kernels do not see).
+struct TraceWorkTotals {
+  uint64_t box_tests = 0, triangle_tests = 0, lookups = 0;
+};
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
-                lsk::LsCounters* counters, Traversal traversal);
+                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work = nullptr);
 
 void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from);
 

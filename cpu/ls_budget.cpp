@@ -34,15 +34,9 @@ struct Traced {
 Traced trace_counted(const Accel& accel, const std::vector<lsk::Ray>& rays) {
   Traced out;
   out.hits.resize(rays.size());
-  const lsk::TraceContext context = accel.context();
-  tbb::enumerable_thread_specific<double> work(0.0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-    lsk::TraceContext local = context;
-    for (size_t i = r.begin(); i != r.end(); ++i) out.hits[i] = trace_ray_counted(local, accel, rays[i], false);
-    work.local() += double(local.trace_work.box_tests) + kTriangleWeight * double(local.trace_work.triangle_tests) +
-                    kLookupWeight * double(local.ls_counters.lookups);
-  });
-  for (double w : work) out.work += w;
+  TraceWorkTotals w;
+  trace_rays(accel, rays.data(), out.hits.data(), rays.size(), false, nullptr, Traversal::Reference, &w);
+  out.work = double(w.box_tests) + kTriangleWeight * double(w.triangle_tests) + kLookupWeight * double(w.lookups);
   return out;
 }
 

@@ -65,10 +65,17 @@ class CpuBackend : public Backend {
   void print_build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options, bool json) override {
     ls::print_build(build_accel(scene, spec, options), json);
   }
+  // With --traversal reference the log line adds the kernels' work counts (the 2l-ls:auto work model
+  // is fitted to them: README, "2l-ls:auto").
   std::vector<lsk::Hit> trace(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, lsk::LsCounters* counters,
-                              std::string*) override {
+                              std::string* note) override {
     std::vector<lsk::Hit> hits(rays.size());
-    trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, counters);
+    TraceWorkTotals work;
+    const bool reference = accel.traversal == Traversal::Reference;
+    trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, counters, accel.traversal, reference ? &work : nullptr);
+    if (reference && note)
+      *note = "; reference work: " + std::to_string(work.box_tests) + " box tests, " + std::to_string(work.triangle_tests) +
+              " triangle tests, " + std::to_string(work.lookups) + " lookups";
     return hits;
   }
   RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
