@@ -81,6 +81,19 @@ double timed(F&& f) {
 
 }  // namespace
 
+std::vector<uint32_t> render_pixels(const RenderOptions& options) {
+  const uint32_t pixels = options.width * options.height;
+  if (options.pixels.empty()) {
+    std::vector<uint32_t> all(pixels);
+    for (uint32_t p = 0; p < pixels; ++p) all[p] = p;
+    return all;
+  }
+  for (size_t i = 0; i < options.pixels.size(); ++i)
+    if (options.pixels[i] >= pixels || (i > 0 && options.pixels[i] <= options.pixels[i - 1]))
+      throw InputError("render: the pixels to render must be ascending indices into the image");
+  return options.pixels;
+}
+
 uint64_t RenderResult::indirect_rays() const {
   uint64_t n = 0;
   for (size_t k = 1; k < bounces.size(); ++k) n += bounces[k].extension_rays + bounces[k].shadow_rays;
@@ -136,6 +149,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
     result.bounces[size_t(k)].structure = name;
   }
 
+  const std::vector<uint32_t> order = render_pixels(options);  // the pixels this render computes
   std::vector<lsk::PathState> paths(pixels);
   std::vector<lsk::Hit> hits(pixels);
   std::vector<uint32_t> active;
@@ -146,7 +160,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
     const uint32_t sample = uint32_t(s);
-    tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) { shading.start_path(p, sample, cam, paths[p]); });
+    tbb::parallel_for(size_t(0), order.size(), [&](size_t i) { shading.start_path(order[i], sample, cam, paths[order[i]]); });
 
     for (int k = 0; k <= bounces; ++k) {
       throw_if_interrupted();
@@ -159,7 +173,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       // the pixels in batch order.
       auto trace_selected = [&](auto selected, auto ray_of, bool any_hit) {
         active.clear();
-        for (uint32_t p = 0; p < pixels; ++p)
+        for (uint32_t p : order)
           if (selected(p)) active.push_back(p);
         batch.resize(active.size());
         batch_hits.resize(active.size());

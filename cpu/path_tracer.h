@@ -35,7 +35,14 @@ struct RenderOptions {
   uint32_t width = 512;
   uint32_t height = 512;
   uint32_t seed = 1;
+  // The pixels to render, row-major indices in ascending order (a sharded render's tiles:
+  // tile_selection.h); empty: every pixel.  The others stay black and trace no ray.  Random numbers are
+  // keyed by the global pixel index, so a rendered pixel's value does not depend on which others are.
+  std::vector<uint32_t> pixels;
 };
+
+// options.pixels, or every pixel when it is empty; throws InputError unless ascending and in the image.
+std::vector<uint32_t> render_pixels(const RenderOptions& options);
 
 struct BounceStats {
   uint64_t extension_rays = 0;  // camera rays at bounce 0

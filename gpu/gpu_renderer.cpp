@@ -83,6 +83,8 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
   constants.shade = shading.shade;
   constants.cam = camera_frame(scene.camera, options.width, options.height);
   const Buffer constant_buffer = make_buffer(context, std::vector<ShadeConstants>{constants}, "constants");
+  const std::vector<uint32_t> order = render_pixels(options);  // the pixels this render computes
+  const Buffer selection = make_buffer(context, order, "selection");
   const Buffer paths(context, size_t(pixels) * sizeof(lsk::PathState), "paths");
   Buffer images(context, size_t(bounces + 1) * pixels * 3 * sizeof(float), "images");
   Buffer dropped(context, size_t(pixels) * sizeof(uint32_t), "dropped");
@@ -93,11 +95,11 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
 
   ComputePipeline shade(context, spirv_shade(), 17, sizeof(ShadePush));
   GpuTracer tracer(context);
-  // One shade.comp step over `count` entries of `batch` (its pixels and hits), appending to next/shadow.
-  auto run_shade = [&](ShadePush push, const RayList& batch, RayList& out_next) {
+  // One shade.comp step over `count` entries of a batch (its pixels and hits), appending to next/shadow.
+  auto run_shade = [&](ShadePush push, const Buffer& batch_pixels, const Buffer& batch_hits, RayList& out_next) {
     if (push.count == 0) return;
     shade.bind({&instances, &vertices, &triangles, &materials, &light_buffer, &cdf, &constant_buffer, &paths, &images,
-                &dropped, &batch.pixels, &batch.hits, &out_next.rays, &out_next.pixels, &shadow.rays, &shadow.pixels,
+                &dropped, &batch_pixels, &batch_hits, &out_next.rays, &out_next.pixels, &shadow.rays, &shadow.pixels,
                 &counts});
     context.submit_and_wait([&](VkCommandBuffer cmd) { shade.record(cmd, &push, (push.count + kGroup - 1) / kGroup); });
   };
@@ -116,9 +118,9 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     ShadePush push;
     push.sample_index = uint32_t(s);
     push.mode = 0;
-    push.count = pixels;
-    run_shade(push, extension, extension);  // writes the camera rays into extension's list
-    uint32_t extension_count = pixels;
+    push.count = uint32_t(order.size());
+    run_shade(push, selection, extension.hits, extension);  // the selected pixels' camera rays into extension's list
+    uint32_t extension_count = push.count;
     for (int k = 0; k <= bounces; ++k) {
       throw_if_interrupted();
       BounceStats& stats = result.bounces[size_t(k)];
@@ -131,14 +133,14 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
       push.bounce = uint32_t(k);
       push.count = extension_count;
       push.image_offset = uint32_t(k) * pixels * 3;
-      run_shade(push, extension, next);
+      run_shade(push, extension.pixels, extension.hits, next);
       uint32_t got[2];
       counts.download(got, sizeof(got));
       stats.shadow_rays += got[1];
       trace_list(k, shadow, got[1], true);
       push.mode = 2;
       push.count = got[1];
-      run_shade(push, shadow, next);
+      run_shade(push, shadow.pixels, shadow.hits, next);
       std::swap(extension, next);
       extension_count = got[0];
     }

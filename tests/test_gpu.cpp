@@ -6,6 +6,7 @@
 #include "load_scene.h"
 #include "path_tracer.h"
 #include "ray_generators.h"
+#include "tile_selection.h"
 
 #include <catch2/catch.hpp>
 
@@ -199,4 +200,32 @@ TEST_CASE("a GPU render gives the CPU render's images bit for bit", "[gpu]") {
   float sum = 0.0f;
   for (const glm::vec3& c : gpu.total) sum += c.x + c.y + c.z;
   REQUIRE(sum > 0.0f);
+}
+
+TEST_CASE("a GPU render of some tiles gives the CPU single render's pixels there bit for bit, black elsewhere", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  RenderOptions options;
+  options.schedule = parse_schedule("bvh,2l-ls:2:6");
+  options.width = 37;
+  options.height = 21;
+  options.spp = 2;
+  options.bounces = 2;
+  options.seed = 3;
+  const std::map<std::string, Accel> cpu_built = build_schedule_structures(cornell, options.schedule);
+  const std::map<std::string, Accel> gpu_built = gpu::build_schedule_structures_gpu(device(), cornell, options.schedule);
+  const RenderResult single = render(cornell, cpu_built, options);
+  const TileGrid grid{options.width, options.height, 8};
+  RenderOptions shard = options;
+  shard.pixels = tile_pixels(grid, parse_shard("1/3", grid));
+  const RenderResult gpu = gpu::render_gpu(device(), cornell, gpu_built, shard);
+  std::vector<char> mine(single.total.size(), 0);
+  for (uint32_t p : shard.pixels) mine[p] = 1;
+  const glm::vec3 zero(0.0f);
+  for (size_t p = 0; p < mine.size(); ++p) {
+    INFO("pixel " << p);
+    REQUIRE(std::memcmp(&gpu.total[p], mine[p] ? &single.total[p] : &zero, sizeof(glm::vec3)) == 0);
+    for (size_t k = 0; k < gpu.bounce_images.size(); ++k)
+      REQUIRE(std::memcmp(&gpu.bounce_images[k][p], mine[p] ? &single.bounce_images[k][p] : &zero, sizeof(glm::vec3)) == 0);
+  }
+  REQUIRE(gpu.bounces[0].extension_rays == shard.pixels.size() * size_t(shard.spp));  // camera rays of its pixels only
 }

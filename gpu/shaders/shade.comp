@@ -1,7 +1,8 @@
 #version 450
 // The path tracer's wavefront steps on the GPU, one invocation per path (common/kernels/shade_path.h,
 // the kernel the CPU renderer calls):
-//   mode 0: start every pixel's path at the camera and list its ray for bounce 0;
+//   mode 0: start the path of every listed pixel (batch_pixels: all, or a shard's tiles) at the camera
+//           and list its ray for bounce 0;
 //   mode 1: shade the hits of the listed paths, add what they found to the bounce image, and append
 //           their shadow rays and next segments (atomically; the order of a batch changes no image);
 //   mode 2: add the light of the shadow rays that reached their light.
@@ -32,7 +33,7 @@ layout(push_constant) uniform ShadePush {
   uint mode;
   uint sample_index;
   uint bounce;
-  uint count;         // paths (mode 0) or batch entries (modes 1, 2)
+  uint count;         // batch entries: pixels to start (mode 0), hits to shade (modes 1, 2)
   uint image_offset;  // first float of this bounce's image
   uint pad0;
   uint pad1;
@@ -44,15 +45,15 @@ layout(push_constant) uniform ShadePush {
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.count) return;
+  uint p = batch_pixels[i];
   if (pc.mode == 0u) {
     PathState path;
-    start_path(i, pc.sample_index, cam, path);
-    paths[i] = path;
+    start_path(p, pc.sample_index, cam, path);
+    paths[p] = path;
     next_rays[i] = path.ray;
-    next_pixels[i] = i;
+    next_pixels[i] = p;
     return;
   }
-  uint p = batch_pixels[i];
   uint base = pc.image_offset + 3u * p;
   vec3 pixel = vec3(images[base], images[base + 1u], images[base + 2u]);
   uint d = dropped[p];
