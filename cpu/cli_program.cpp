@@ -8,6 +8,7 @@
 #include "ray_files.h"
 #include "ray_generators.h"
 #include "render_output.h"
+#include "render_shards.h"
 
 #include <CLI/CLI.hpp>
 
@@ -37,6 +38,9 @@ struct Values {
   int repeats = 5;
   std::string bench_kind = "diffuse";
   bool bench_any_hit = false;
+  uint32_t tile_size = 32;  // sharded renders (render_shards.h)
+  std::string tiles, shard;
+  std::vector<std::string> partials;
 };
 
 struct Commands {
@@ -45,6 +49,7 @@ struct Commands {
   CLI::App* rays = nullptr;
   CLI::App* render = nullptr;
   CLI::App* bench = nullptr;
+  CLI::App* merge = nullptr;
 };
 
 Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
@@ -84,6 +89,15 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.render->add_option("--out", v.out_dir, "output folder")->capture_default_str();
   c.render->add_option("--seed", v.seed)->capture_default_str();
   c.render->add_flag("--quiet", v.quiet, "no progress bar");
+  c.render->add_option("--tile-size", v.tile_size, "tile edge in pixels for --tiles and --shard")
+      ->capture_default_str()->check(CLI::Range(1, 16384));
+  auto* tiles = c.render->add_option("--tiles", v.tiles, "render only tiles A..B-1 (row-major) and write a partial for merge");
+  c.render->add_option("--shard", v.shard, "render only the tiles t with t mod N == K and write a partial for merge")
+      ->excludes(tiles);
+
+  c.merge = app.add_subcommand("merge", "combine the partials of a sharded render into the single render's files");
+  c.merge->add_option("--out", v.out_dir, "output folder")->required();
+  c.merge->add_option("partials", v.partials, "partial EXRs written by render --shard or --tiles")->required();
 
   c.bench = app.add_subcommand("bench", "MRays/s of each structure on the same rays, in one run");
   common(c.bench, true);
@@ -117,6 +131,8 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   options.seed = v.seed;
   const AccelOptions accel_options = v.ls.options();
   check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
+  const ShardChoice shard = choose_tiles(v.tiles, v.shard, v.tile_size, options.width, options.height);
+  if (shard.sharded()) options.pixels = tile_pixels(shard.grid, shard.tiles);  // a shard: only its tiles
   std::map<std::string, Accel> built;
   for (const StructureSpec& spec : options.schedule.per_bounce)
     if (!built.count(spec.name())) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
@@ -131,8 +147,14 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   const RenderResult result = backend.render(scene, built, options, progress);
   const std::string device = backend.device();
   RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device};
-  write_render_outputs(v.out_dir, result, ctx);
-  std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
+  if (shard.sharded()) {
+    const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls);
+    std::printf("wrote %s.{exr, json} (a partial for merge): %zu of the image's %s\n", stem.c_str(), shard.tiles.size(),
+                shard.grid.describe().c_str());
+  } else {
+    write_render_outputs(v.out_dir, result, ctx);
+    std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
+  }
   std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
               v.scene.c_str(), options.width, options.height, v.spp, options.bounces, options.schedule.name().c_str(),
               device.empty() ? "" : " on ", device.c_str(), result.seconds, result.indirect_mrays_per_s(),
@@ -142,6 +164,12 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
 }
 
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {
+  if (*c.merge) {  // files only: no scene, no backend (no device) needed
+    merge_render_outputs(v.out_dir, v.partials);
+    std::printf("merged %zu partials into %s/{total.exr, bounce_K.exr, image.png, report.json}\n", v.partials.size(),
+                v.out_dir.c_str());
+    return;
+  }
   const Scene scene = load_scene(v.scene);
   if (*c.rays) {  // host work only: no backend (no device) needed
     write_rays(v.out_path, make_rays(scene, v.kind, v.count, v.seed));
