@@ -40,6 +40,7 @@ struct Values {
   bool bench_any_hit = false;
   uint32_t tile_size = 32;  // sharded renders (render_shards.h)
   std::string tiles, shard;
+  std::string throughput_switch;  // "T:STRUCTURE" (throughput_switch.h)
   std::vector<std::string> partials;
 };
 
@@ -89,6 +90,8 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.render->add_option("--out", v.out_dir, "output folder")->capture_default_str();
   c.render->add_option("--seed", v.seed)->capture_default_str();
   c.render->add_flag("--quiet", v.quiet, "no progress bar");
+  c.render->add_option("--throughput-switch", v.throughput_switch,
+                       "T:STRUCTURE: paths whose throughput luminance is below T trace that bounce's rays with STRUCTURE");
   c.render->add_option("--tile-size", v.tile_size, "tile edge in pixels for --tiles and --shard")
       ->capture_default_str()->check(CLI::Range(1, 16384));
   auto* tiles = c.render->add_option("--tiles", v.tiles, "render only tiles A..B-1 (row-major) and write a partial for merge");
@@ -129,6 +132,7 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   options.spp = v.spp;
   options.bounces = v.bounces;
   options.seed = v.seed;
+  if (!v.throughput_switch.empty()) options.throughput_switch = parse_throughput_switch(v.throughput_switch);
   const AccelOptions accel_options = v.ls.options();
   check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
   const ShardChoice shard = choose_tiles(v.tiles, v.shard, v.tile_size, options.width, options.height);
@@ -136,6 +140,9 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   std::map<std::string, Accel> built;
   for (const StructureSpec& spec : options.schedule.per_bounce)
     if (!built.count(spec.name())) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
+  const ThroughputSwitch& policy = options.throughput_switch;
+  if (policy.enabled() && !built.count(policy.structure.name()))
+    built.emplace(policy.structure.name(), backend.build(scene, policy.structure, accel_options));
   const bool show = !v.quiet && isatty(2);
   const Progress progress = [&](int done, int total) {
     if (!show) return;
@@ -146,7 +153,7 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   };
   const RenderResult result = backend.render(scene, built, options, progress);
   const std::string device = backend.device();
-  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device};
+  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, policy};
   if (shard.sharded()) {
     const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls);
     std::printf("wrote %s.{exr, json} (a partial for merge): %zu of the image's %s\n", stem.c_str(), shard.tiles.size(),
@@ -155,8 +162,9 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
     write_render_outputs(v.out_dir, result, ctx);
     std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
   }
-  std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
+  std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
               v.scene.c_str(), options.width, options.height, v.spp, options.bounces, options.schedule.name().c_str(),
+              policy.enabled() ? ", throughput switch " : "", policy.enabled() ? policy.name().c_str() : "",
               device.empty() ? "" : " on ", device.c_str(), result.seconds, result.indirect_mrays_per_s(),
               (unsigned long long)result.indirect_rays(), result.indirect_seconds());
   if (result.dropped_samples)

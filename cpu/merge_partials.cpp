@@ -34,6 +34,10 @@ void add_shard_stats(RenderResult& r, const Partial& p) {
       s.shadow_rays += b.at("shadow_rays").get<uint64_t>();
       s.trace_seconds += b.at("seconds").get<double>();
       add_counters(s.ls, get_ls_counters(b, "ls_"));
+      s.switched_extension_rays += b.at("switched_extension_rays").get<uint64_t>();
+      s.switched_shadow_rays += b.at("switched_shadow_rays").get<uint64_t>();
+      s.switched_seconds += b.at("switched_seconds").get<double>();
+      add_counters(s.switched_ls, get_ls_counters(b, "switched_ls_"));
     }
     r.dropped_samples += p.report.at("dropped_samples").get<uint64_t>();
     r.seconds += p.report.at("seconds").get<double>();
@@ -117,9 +121,10 @@ MergedRender merge_partials(const std::vector<std::string>& paths) {
   std::string device;
   for (const std::string& d : devices) device += (device.empty() ? "" : "; ") + d;
   const RenderReportContext context{first.header.scene, first.header.schedule, first.header.spp, first.header.seed, nullptr,
-                                    device};
+                                    device, ThroughputSwitch{}};
   m.report = render_report(r, context);
   m.report["structures"] = structures;
+  m.report["throughput_switch"] = first.report.value("throughput_switch", nlohmann::json(nullptr));
   m.report["threads"] = same_threads ? shards.front()["threads"] : nlohmann::json(0);
   m.report["tile_size"] = first.header.tile_size;
   m.report["shards"] = shards;

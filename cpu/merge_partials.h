@@ -5,7 +5,8 @@
 //
 // Refused, with a one-line reason (InputError): a file that cannot be read or is not a partial,
 // partials of different renders (the attribute that differs is named: scene fingerprint, schedule,
-// spp, bounces, seed, size, tile size, Line Space flags), a tile in two partials, or tiles in none.
+// spp, bounces, seed, size, tile size, Line Space flags, throughput switch), a tile in two partials, or
+// tiles in none.
 #pragma once
 
 #include "path_tracer.h"

@@ -55,6 +55,12 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
                {"seconds", b.trace_seconds}};
     put_ls_counters(entry, "ls_", b.ls);
     entry["mrays_per_s"] = b.trace_seconds > 0.0 ? double(rays) / b.trace_seconds * 1e-6 : 0.0;
+    // The part of the above that the throughput switch traced with its structure.
+    entry["switched_extension_rays"] = b.switched_extension_rays;
+    entry["switched_shadow_rays"] = b.switched_shadow_rays;
+    entry["switched_rays"] = b.switched_extension_rays + b.switched_shadow_rays;
+    entry["switched_seconds"] = b.switched_seconds;
+    put_ls_counters(entry, "switched_ls_", b.switched_ls);
     per_bounce.push_back(entry);
   }
   json structures = json::array();
@@ -84,7 +90,11 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
                 {"mrays_per_s", result.indirect_mrays_per_s()}}},
               {"per_bounce", per_bounce},
               {"structures", structures},
-              {"dropped_samples", result.dropped_samples}};
+              {"dropped_samples", result.dropped_samples},
+              {"throughput_switch", context.throughput_switch.enabled()
+                                        ? json{{"threshold", context.throughput_switch.threshold},
+                                               {"structure", context.throughput_switch.structure.name()}}
+                                        : json(nullptr)}};
 }
 
 void create_output_folder(const std::string& dir) {

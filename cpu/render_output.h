@@ -16,6 +16,7 @@ struct RenderReportContext {
   uint32_t seed = 0;
   const std::map<std::string, Accel>* structures = nullptr;
   std::string device;  // who traced: empty for this CPU ("cpu: MODEL" in the report)
+  ThroughputSwitch throughput_switch;  // off: the report's "throughput_switch" is null
 };
 
 nlohmann::json render_report(const RenderResult& result, const RenderReportContext& context);

@@ -37,7 +37,8 @@ std::vector<std::pair<std::string, std::string>> render_identity(const PartialHe
           {"width", std::to_string(h.width)},
           {"height", std::to_string(h.height)},
           {"tile_size", std::to_string(h.tile_size)},
-          {"ls_flags", h.ls_flags}};
+          {"ls_flags", h.ls_flags},
+          {"throughput_switch", h.throughput_switch}};
 }
 
 std::string ls_flags_text(const LsOptions& o) {
@@ -75,6 +76,7 @@ void write_partial(const std::string& path, const PartialHeader& h, const Render
                    {kPrefix + "schedule", h.schedule},
                    {kPrefix + "seed", std::to_string(h.seed)},
                    {kPrefix + "ls_flags", h.ls_flags},
+                   {kPrefix + "throughput_switch", h.throughput_switch},
                    {kPrefix + "tiles", tile_ranges_text(h.tiles)},
                    {kPrefix + "selection", h.selection},
                    {kPrefix + "report", report.dump()}};
@@ -114,6 +116,7 @@ Partial read_partial(const std::string& path) {
   h.scene_fingerprint = text("scene_fingerprint");
   h.schedule = text("schedule");
   h.ls_flags = text("ls_flags");
+  h.throughput_switch = text("throughput_switch");
   h.selection = text("selection");
   h.spp = number("spp", 1, 1 << 16);
   h.bounces = number("bounces", 0, 64);

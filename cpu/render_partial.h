@@ -6,8 +6,9 @@
 //   format             "linespace-partial-1"
 //   scene              the --scene text (informative: paths differ between machines)
 //   scene_fingerprint  16 hex digits of the loaded scene's content (scene_fingerprint.h)
-//   schedule, spp, bounces, seed, width, height, tile_size, ls_flags
-//                      the render's settings; ls_flags lists the Line Space flags that change images
+//   schedule, spp, bounces, seed, width, height, tile_size, ls_flags, throughput_switch
+//                      the render's settings; ls_flags lists the Line Space flags that change images,
+//                      throughput_switch is "T:STRUCTURE" or "off"
 //   tile_count         tiles of the whole image
 //   tiles              the shard's tiles, as ranges ("0-3,8,11")
 //   selection          the flag that chose them ("--shard 1/3")
@@ -30,7 +31,7 @@ namespace ls {
 inline constexpr const char* kPartialFormat = "linespace-partial-1";
 
 struct PartialHeader {
-  std::string scene, scene_fingerprint, schedule, ls_flags, selection;
+  std::string scene, scene_fingerprint, schedule, ls_flags, throughput_switch = "off", selection;
   int spp = 0, bounces = 0;
   uint32_t seed = 0, width = 0, height = 0, tile_size = 0;
   TileSet tiles;

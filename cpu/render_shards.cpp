@@ -32,6 +32,7 @@ std::string write_shard_outputs(const std::string& dir, const ShardChoice& choic
   h.scene_fingerprint = fingerprint_text(scene_fingerprint(scene));
   h.schedule = context.schedule;
   h.ls_flags = ls_flags_text(ls);
+  h.throughput_switch = context.throughput_switch.name();
   h.selection = choice.selection;
   h.spp = context.spp;
   h.bounces = int(result.bounces.size()) - 1;

@@ -2,6 +2,7 @@
 // every shaft, traced hits (closest and any hit, all four structures), and renders.  These run on
 // whatever Vulkan device the machine has (lavapipe in CI); with no device at all they FAIL.
 #include "cross_check.h"
+#include "gpu_line_space.h"
 #include "gpu_renderer.h"
 #include "load_scene.h"
 #include "path_tracer.h"
@@ -228,4 +229,36 @@ TEST_CASE("a GPU render of some tiles gives the CPU single render's pixels there
       REQUIRE(std::memcmp(&gpu.bounce_images[k][p], mine[p] ? &single.bounce_images[k][p] : &zero, sizeof(glm::vec3)) == 0);
   }
   REQUIRE(gpu.bounces[0].extension_rays == shard.pixels.size() * size_t(shard.spp));  // camera rays of its pixels only
+}
+
+TEST_CASE("a GPU render with the throughput switch gives the CPU's images, counts and decisions bit for bit", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  RenderOptions options;
+  options.schedule = parse_schedule("bvh,f-ls:3:6");
+  options.throughput_switch = parse_throughput_switch("0.35:2l-ls:2:6");
+  options.width = 40;
+  options.height = 28;
+  options.spp = 2;
+  options.bounces = 3;
+  options.seed = 9;
+  const auto cpu_built = build_schedule_structures(cornell, options.schedule, paper(), options.throughput_switch);
+  std::map<std::string, Accel> gpu_built;
+  for (const StructureSpec& spec : render_structures(options))
+    gpu_built.emplace(spec.name(), gpu::build_accel_gpu(device(), cornell, spec, paper()));
+  const RenderResult cpu = render(cornell, cpu_built, options);
+  const RenderResult gpu = gpu::render_gpu(device(), cornell, gpu_built, options);
+  uint64_t switched = 0;
+  for (size_t k = 0; k < cpu.bounce_images.size(); ++k) {
+    INFO("bounce " << k);
+    REQUIRE(cpu.bounces[k].extension_rays == gpu.bounces[k].extension_rays);
+    REQUIRE(cpu.bounces[k].shadow_rays == gpu.bounces[k].shadow_rays);
+    REQUIRE(cpu.bounces[k].switched_extension_rays == gpu.bounces[k].switched_extension_rays);
+    REQUIRE(cpu.bounces[k].switched_shadow_rays == gpu.bounces[k].switched_shadow_rays);
+    REQUIRE(std::memcmp(&cpu.bounces[k].ls, &gpu.bounces[k].ls, sizeof(lsk::LsCounters)) == 0);
+    REQUIRE(std::memcmp(&cpu.bounces[k].switched_ls, &gpu.bounces[k].switched_ls, sizeof(lsk::LsCounters)) == 0);
+    REQUIRE(std::memcmp(cpu.bounce_images[k].data(), gpu.bounce_images[k].data(), cpu.bounce_images[k].size() * sizeof(glm::vec3)) == 0);
+    switched += cpu.bounces[k].switched_extension_rays;
+  }
+  REQUIRE(switched > 0);  // the switch was in play
+  REQUIRE(cpu.bounces[2].switched_ls.lookups > 0);
 }

@@ -59,7 +59,7 @@ struct Fixture {
     o.pixels = tile_pixels(grid, tiles);
     return render(scene, built, o);
   }
-  RenderReportContext context() const { return RenderReportContext{"builtin:cornell", options.schedule.name(), options.spp, options.seed, &built, ""}; }
+  RenderReportContext context() const { return RenderReportContext{"builtin:cornell", options.schedule.name(), options.spp, options.seed, &built, "", ThroughputSwitch{}}; }
   // Writes the partial of `choice` into dir and returns its EXR path.
   std::string write(const ShardChoice& choice, const fs::path& dir, RenderOptions o) {
     o.pixels = tile_pixels(choice.grid, choice.tiles);

@@ -48,6 +48,19 @@ TEST_CASE("shards by --shard and by uneven --tiles, merged, equal the single ren
   INFO(m.err);
   REQUIRE(m.status == 0);
   require_same_render(temp("single"), temp("merged_ranges"), 3);
+
+  // With the throughput switch: its decisions are per path, so shards make the single run's.
+  const std::string policy = "--throughput-switch 0.3:2l-ls:2:6 ";
+  render_ok(policy + "--out " + temp("single_policy").string());
+  for (int k = 0; k < 2; ++k) render_ok(policy + "--shard " + std::to_string(k) + "/2 --out " + temp("policy").string());
+  m = cpu("merge --out " + temp("merged_policy").string() + " " + (temp("policy") / "partial-shard-0-of-2.exr").string() + " " +
+          (temp("policy") / "partial-shard-1-of-2.exr").string());
+  INFO(m.err);
+  REQUIRE(m.status == 0);
+  require_same_render(temp("single_policy"), temp("merged_policy"), 2);
+  const auto report = nlohmann::json::parse(slurp(temp("merged_policy") / "report.json"));
+  REQUIRE(report.at("throughput_switch").at("structure") == "2l-ls:2:6");
+  REQUIRE(report.at("per_bounce").at(2).at("switched_rays").get<int>() > 0);
 }
 
 TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-line reason", "[shards_cli]") {
@@ -58,6 +71,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
   render_ok("--shard 1/3 --out " + temp("spp").string(), render_args("1"));
   render_ok("--shard 1/3 --seed 9 --out " + temp("seed").string());
   render_ok("--shard 1/3 --ls-angle 30 --out " + temp("angle").string());
+  render_ok("--shard 1/3 --throughput-switch 0.3:bvh --out " + temp("switch").string());
   render_ok("--shard 1/3 --out " + temp("schedule").string(), render_args("2", "bvh"));
   render_ok("--shard 1/3 --out " + temp("tile").string(), render_args("2", "bvh,f-ls:3:6", "9"));
   REQUIRE(cpu("render --scene builtin:generated:500:2:1 --size 45x29 --spp 2 --bounces 2 --schedule bvh,f-ls:3:6 "
@@ -72,7 +86,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
                     s2 = part(parts, "partial-shard-2-of-3");
   const std::string out = " --out " + temp("refused").string() + " ";
   const std::string merge = "merge";
-  const std::array<std::pair<std::string, std::string>, 22> cases = {{
+  const std::array<std::pair<std::string, std::string>, 23> cases = {{
       {kRender + "--shard 3/3" + out, "K must be less than N"},
       {kRender + "--shard 1/0" + out, "N must be at least 1"},
       {kRender + "--shard 25/30" + out, "no tile"},
@@ -90,6 +104,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
       {merge + out + s0 + part(temp("seed"), "partial-shard-1-of-3") + s2, "seed is '9'"},
       {merge + out + s0 + part(temp("angle"), "partial-shard-1-of-3") + s2, "ls_flags is 'angle=30"},
       {merge + out + s0 + part(temp("schedule"), "partial-shard-1-of-3") + s2, "schedule is 'bvh'"},
+      {merge + out + s0 + part(temp("switch"), "partial-shard-1-of-3") + s2, "throughput_switch is '0.3:bvh'"},
       {merge + out + s0 + part(temp("tile"), "partial-shard-1-of-3") + s2, "tile_size is '9'"},
       {merge + out + s0 + part(temp("scene"), "partial-shard-1-of-3") + s2, "the scene differs"},
       {merge + out + s0 + " " + (temp("single") / "total.exr").string() + s2, "is not a linespace partial"},

@@ -5,7 +5,11 @@
 //           and list its ray for bounce 0;
 //   mode 1: shade the hits of the listed paths, add what they found to the bounce image, and append
 //           their shadow rays and next segments (atomically; the order of a batch changes no image);
-//   mode 2: add the light of the shadow rays that reached their light.
+//   mode 2: add the light of the shadow rays that reached their light;
+//   mode 3: with the throughput switch on, split a list of this bounce's rays: the paths that follow
+//           the schedule to the first output list (next_*), the switched ones to the second (shadow_*).
+//           For extension rays (list_kind 0) it decides first (kernels/throughput_switch.h) and keeps
+//           the decision in the path for its shadow ray (list_kind 1).
 // The host (gpu/gpu_renderer.cpp) traces the lists with trace.comp between these steps.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
@@ -35,12 +39,13 @@ layout(push_constant) uniform ShadePush {
   uint bounce;
   uint count;         // batch entries: pixels to start (mode 0), hits to shade (modes 1, 2)
   uint image_offset;  // first float of this bounce's image
+  uint list_kind;     // mode 3: 0 extension rays, 1 shadow rays
+  float switch_threshold;
   uint pad0;
-  uint pad1;
-  uint pad2;
 } pc;
 
 #include "kernels/shade_path.h"
+#include "kernels/throughput_switch.h"
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -52,6 +57,20 @@ void main() {
     paths[p] = path;
     next_rays[i] = path.ray;
     next_pixels[i] = p;
+    return;
+  }
+  if (pc.mode == 3u) {
+    if (pc.list_kind == 0u) paths[p].switched = throughput_switched(paths[p].throughput, pc.switch_threshold);
+    Ray ray = pc.list_kind == 0u ? paths[p].ray : paths[p].shadow_ray;
+    if (paths[p].switched != 0u) {
+      uint j = atomicAdd(shadow_count, 1u);
+      shadow_rays[j] = ray;
+      shadow_pixels[j] = p;
+    } else {
+      uint j = atomicAdd(next_count, 1u);
+      next_rays[j] = ray;
+      next_pixels[j] = p;
+    }
     return;
   }
   uint base = pc.image_offset + 3u * p;
