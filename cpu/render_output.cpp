@@ -92,7 +92,7 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
               {"structures", structures},
               {"dropped_samples", result.dropped_samples},
               {"throughput_switch", context.throughput_switch.enabled()
-                                        ? json{{"threshold", context.throughput_switch.threshold},
+                                        ? json{{"threshold", std::stod(shortest_text(context.throughput_switch.threshold))},
                                                {"structure", context.throughput_switch.structure.name()}}
                                         : json(nullptr)}};
 }

@@ -9,16 +9,16 @@
 
 namespace ls {
 
-std::string ThroughputSwitch::name() const {
-  if (!enabled()) return "off";
-  // The shortest text that reads back as the same float: "0.3", not "0.300000012".
+std::string shortest_text(float value) {
   char t[32];
   for (int digits = 1; digits <= 9; ++digits) {
-    std::snprintf(t, sizeof(t), "%.*g", digits, double(threshold));
-    if (std::strtof(t, nullptr) == threshold) break;
+    std::snprintf(t, sizeof(t), "%.*g", digits, double(value));
+    if (std::strtof(t, nullptr) == value) break;
   }
-  return std::string(t) + ":" + structure.name();
+  return t;
 }
+
+std::string ThroughputSwitch::name() const { return enabled() ? shortest_text(threshold) + ":" + structure.name() : "off"; }
 
 float parse_switch_threshold(const std::string& text, const std::string& flag) {
   float v = 0.0f;

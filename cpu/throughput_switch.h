@@ -16,6 +16,9 @@ struct ThroughputSwitch {
   std::string name() const;  // "0.25:2l-ls:4:6" (the shortest text of the threshold), "off" when disabled
 };
 
+// The shortest text that reads back as the same float: "0.3", not "0.300000012".
+std::string shortest_text(float value);
+
 // T must be a finite number > 0; throws InputError naming `flag` otherwise.
 float parse_switch_threshold(const std::string& text, const std::string& flag);
 // "T:STRUCTURE"; throws InputError (one line) on anything else.

@@ -170,3 +170,20 @@ TEST_CASE("linespace-gpu shards merged, alone or with a CPU shard, equal linespa
   const auto report = nlohmann::json::parse(slurp(temp("shards/merged_mixed/report.json")));
   CHECK(report.at("device").get<std::string>().find("; ") != std::string::npos);  // both devices named
 }
+
+TEST_CASE("linespace-validate policy on the GPU gives the CPU's RMSE and rays on X", "[gpu_cli]") {
+  const std::string args = "policy --size 24x16 --spp 1 --bounces 2 --structure f-ls:3:6 --thresholds 0.3,0.6 --out ";
+  REQUIRE(run(LINESPACE_VALIDATE, args + temp("policy_cpu").string() + " --device cpu").status == 0);
+  const Run g = run(LINESPACE_VALIDATE, args + temp("policy_gpu").string() + " --device gpu");
+  INFO(g.err);
+  REQUIRE(g.status == 0);
+  const auto cpu = nlohmann::json::parse(slurp(temp("policy_cpu") / "policy.json")).at("points");
+  const auto gpu = nlohmann::json::parse(slurp(temp("policy_gpu") / "policy.json")).at("points");
+  REQUIRE(cpu.size() == 4u);
+  REQUIRE(cpu.size() == gpu.size());
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    CHECK(cpu[i].at("rmse") == gpu[i].at("rmse"));  // the same images
+    CHECK(cpu[i].at("rays_on_x") == gpu[i].at("rays_on_x"));  // the same decisions
+    CHECK(cpu[i].at("indirect_rays") == gpu[i].at("indirect_rays"));
+  }
+}
