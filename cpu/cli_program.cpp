@@ -9,6 +9,7 @@
 #include "ray_generators.h"
 #include "render_frames.h"
 #include "render_output.h"
+#include "render_shards.h"
 
 #include <CLI/CLI.hpp>
 
@@ -42,6 +43,10 @@ struct Values {
   int repeats = 5;
   std::string bench_kind = "diffuse";
   bool bench_any_hit = false;
+  uint32_t tile_size = 32;  // sharded renders (render_shards.h)
+  std::string tiles, shard;
+  std::string throughput_switch;  // "T:STRUCTURE" (throughput_switch.h)
+  std::vector<std::string> partials;
 };
 
 struct Commands {
@@ -50,6 +55,7 @@ struct Commands {
   CLI::App* rays = nullptr;
   CLI::App* render = nullptr;
   CLI::App* bench = nullptr;
+  CLI::App* merge = nullptr;
 };
 
 Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
@@ -97,6 +103,19 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.render->add_flag("--no-flat-comparison", v.no_flat_comparison, "do not time a flat rebuild beside each 2L update")->needs(frames);
   c.render->add_option("--top-level-update", v.top_level, "how 2L structures follow the animation: rebuild or refit their top level")
       ->capture_default_str()->check(CLI::IsMember({"rebuild", "refit"}))->needs(frames);
+  c.render->add_option("--throughput-switch", v.throughput_switch,
+                       "T:STRUCTURE: paths whose throughput luminance is below T trace that bounce's rays with STRUCTURE");
+  c.render->add_option("--tile-size", v.tile_size, "tile edge in pixels for --tiles and --shard")
+      ->capture_default_str()->check(CLI::Range(1, 16384));
+  // A sequence is sharded by frame ranges (--frames A:B on each machine), not by tiles.
+  auto* tiles = c.render->add_option("--tiles", v.tiles, "render only tiles A..B-1 (row-major) and write a partial for merge")
+      ->excludes(frames);
+  c.render->add_option("--shard", v.shard, "render only the tiles t with t mod N == K and write a partial for merge")
+      ->excludes(tiles)->excludes(frames);
+
+  c.merge = app.add_subcommand("merge", "combine the partials of a sharded render into the single render's files");
+  c.merge->add_option("--out", v.out_dir, "output folder")->required();
+  c.merge->add_option("partials", v.partials, "partial EXRs written by render --shard or --tiles")->required();
 
   c.bench = app.add_subcommand("bench", "MRays/s of each structure on the same rays, in one run");
   common(c.bench, true);
@@ -128,6 +147,7 @@ RenderOptions render_options(const Values& v) {
   options.spp = v.spp;
   options.bounces = v.bounces;
   options.seed = v.seed;
+  if (!v.throughput_switch.empty()) options.throughput_switch = parse_throughput_switch(v.throughput_switch);
   return options;
 }
 
@@ -162,20 +182,32 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
     std::fprintf(stderr, "note: %s is animated; a still render does not pose it%s (--frames A:B renders the animation)\n",
                  v.scene.c_str(), weights ? " and ignores its morph-target weight channels" : "");
   }
-  const RenderOptions options = render_options(v);
+  RenderOptions options = render_options(v);
   const AccelOptions accel_options = v.ls.options();
   check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
+  const ShardChoice shard = choose_tiles(v.tiles, v.shard, v.tile_size, options.width, options.height);
+  if (shard.sharded()) options.pixels = tile_pixels(shard.grid, shard.tiles);  // a shard: only its tiles
   std::map<std::string, Accel> built;
   for (const StructureSpec& spec : options.schedule.per_bounce)
     if (!built.count(spec.name())) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
+  const ThroughputSwitch& policy = options.throughput_switch;
+  if (policy.enabled() && !built.count(policy.structure.name()))
+    built.emplace(policy.structure.name(), backend.build(scene, policy.structure, accel_options));
   const Progress progress = progress_bar(v);
   const RenderResult result = backend.render(scene, built, options, progress);
   const std::string device = backend.device();
-  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr};
-  write_render_outputs(v.out_dir, result, ctx);
-  std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
-  std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
+  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr, policy};
+  if (shard.sharded()) {
+    const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls);
+    std::printf("wrote %s.{exr, json} (a partial for merge): %zu of the image's %s\n", stem.c_str(), shard.tiles.size(),
+                shard.grid.describe().c_str());
+  } else {
+    write_render_outputs(v.out_dir, result, ctx);
+    std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
+  }
+  std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
               v.scene.c_str(), options.width, options.height, v.spp, options.bounces, options.schedule.name().c_str(),
+              policy.enabled() ? ", throughput switch " : "", policy.enabled() ? policy.name().c_str() : "",
               device.empty() ? "" : " on ", device.c_str(), result.seconds, result.indirect_mrays_per_s(),
               (unsigned long long)result.indirect_rays(), result.indirect_seconds());
   if (result.dropped_samples)
@@ -192,8 +224,18 @@ void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v)
 
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   if (*c.build || *c.trace) check_budget_flag({parse_structure(v.structure)}, v);
-  if (*c.render) check_budget_flag(parse_schedule(v.schedule).per_bounce, v);
+  if (*c.render) {
+    std::vector<StructureSpec> specs = parse_schedule(v.schedule).per_bounce;
+    if (!v.throughput_switch.empty()) specs.push_back(parse_throughput_switch(v.throughput_switch).structure);
+    check_budget_flag(specs, v);
+  }
   if (*c.bench) check_budget_flag(parse_structure_list(v.structures), v);
+  if (*c.merge) {  // files only: no scene, no backend (no device) needed
+    merge_render_outputs(v.out_dir, v.partials);
+    std::printf("merged %zu partials into %s/{total.exr, bounce_K.exr, image.png, report.json}\n", v.partials.size(),
+                v.out_dir.c_str());
+    return;
+  }
   const Scene scene = load_scene(v.scene);
   if (*c.rays) {  // host work only: no backend (no device) needed
     write_rays(v.out_path, make_rays(scene, v.kind, v.count, v.seed));

@@ -3,6 +3,7 @@
 #include "interrupt.h"
 #include "kernels/sampling.h"
 #include "kernels/scaled_geometry.h"
+#include "kernels/throughput_switch.h"
 #include "surface.h"
 
 #include <tbb/parallel_for.h>
@@ -72,6 +73,36 @@ lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& l
 
 namespace {
 
+// The throughput switch's structure as the render loop uses it (accel null: the switch is off).
+struct SwitchedTracing {
+  const Accel* accel = nullptr;
+  float threshold = 0.0f;
+};
+
+SwitchedTracing switched_tracing(const std::map<std::string, Accel>& structures, const ThroughputSwitch& s) {
+  SwitchedTracing t;
+  if (!s.enabled()) return t;
+  const auto it = structures.find(s.structure.name());
+  if (it == structures.end()) throw InputError("render: structure '" + s.structure.name() + "' was not built");
+  t.accel = &it->second;
+  t.threshold = s.threshold;
+  return t;
+}
+
+// Orders `active` as the paths that follow the schedule, then those switched at this bounce (both in
+// pixel order); returns how many follow the schedule.
+size_t partition_switched(std::vector<uint32_t>& active, const std::vector<lsk::PathState>& paths) {
+  return size_t(std::stable_partition(active.begin(), active.end(), [&](uint32_t p) { return paths[p].switched == 0u; }) -
+                active.begin());
+}
+
+void add_switched(BounceStats& stats, const lsk::LsCounters& counters, double seconds) {
+  stats.trace_seconds += seconds;
+  stats.switched_seconds += seconds;
+  add_counters(stats.ls, counters);
+  add_counters(stats.switched_ls, counters);
+}
+
 template <typename F>
 double timed(F&& f) {
   const auto start = std::chrono::steady_clock::now();
@@ -80,6 +111,19 @@ double timed(F&& f) {
 }
 
 }  // namespace
+
+std::vector<uint32_t> render_pixels(const RenderOptions& options) {
+  const uint32_t pixels = options.width * options.height;
+  if (options.pixels.empty()) {
+    std::vector<uint32_t> all(pixels);
+    for (uint32_t p = 0; p < pixels; ++p) all[p] = p;
+    return all;
+  }
+  for (size_t i = 0; i < options.pixels.size(); ++i)
+    if (options.pixels[i] >= pixels || (i > 0 && options.pixels[i] <= options.pixels[i - 1]))
+      throw InputError("render: the pixels to render must be ascending indices into the image");
+  return options.pixels;
+}
 
 uint64_t RenderResult::indirect_rays() const {
   uint64_t n = 0;
@@ -99,11 +143,25 @@ double RenderResult::indirect_mrays_per_s() const {
 }
 
 std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule,
-                                                       const AccelOptions& options) {
+                                                       const AccelOptions& options, const ThroughputSwitch& throughput_switch) {
   std::map<std::string, Accel> built;
   for (const StructureSpec& spec : schedule.per_bounce)
     if (!built.count(spec.name())) built.emplace(spec.name(), build_accel(scene, spec, options));
+  if (throughput_switch.enabled() && !built.count(throughput_switch.structure.name()))
+    built.emplace(throughput_switch.structure.name(), build_accel(scene, throughput_switch.structure, options));
   return built;
+}
+
+std::vector<StructureSpec> render_structures(const RenderOptions& options) {
+  std::vector<StructureSpec> specs;
+  auto add = [&](const StructureSpec& spec) {
+    for (const StructureSpec& s : specs)
+      if (s == spec) return;
+    specs.push_back(spec);
+  };
+  for (int k = 0; k <= options.bounces; ++k) add(options.schedule.at(k));
+  if (options.throughput_switch.enabled()) add(options.throughput_switch.structure);
+  return specs;
 }
 
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
@@ -135,7 +193,9 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
     accel[size_t(k)] = &it->second;
     result.bounces[size_t(k)].structure = name;
   }
+  const SwitchedTracing switched = switched_tracing(structures, options.throughput_switch);
 
+  const std::vector<uint32_t> order = render_pixels(options);  // the pixels this render computes
   std::vector<lsk::PathState> paths(pixels);
   std::vector<lsk::Hit> hits(pixels);
   std::vector<uint32_t> active;
@@ -146,7 +206,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
     const uint32_t sample = uint32_t(s);
-    tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) { shading.start_path(p, sample, cam, paths[p]); });
+    tbb::parallel_for(size_t(0), order.size(), [&](size_t i) { shading.start_path(order[i], sample, cam, paths[order[i]]); });
 
     for (int k = 0; k <= bounces; ++k) {
       throw_if_interrupted();
@@ -156,22 +216,37 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       std::vector<glm::vec3>& image = result.bounce_images[size_t(k)];
 
       // Gathers the rays of the selected pixels into one batch and traces it, timed; `active` lists
-      // the pixels in batch order.
-      auto trace_selected = [&](auto selected, auto ray_of, bool any_hit) {
+      // the pixels in batch order.  With the throughput switch on, the switched paths' rays come last
+      // and are traced as a second batch with the switch's structure.
+      auto trace_selected = [&](auto selected, auto ray_of, bool any_hit, uint64_t& switched_rays) {
         active.clear();
-        for (uint32_t p = 0; p < pixels; ++p)
+        for (uint32_t p : order)
           if (selected(p)) active.push_back(p);
+        const size_t kept = switched.accel ? partition_switched(active, paths) : active.size();
         batch.resize(active.size());
         batch_hits.resize(active.size());
         for (size_t i = 0; i < active.size(); ++i) batch[i] = ray_of(active[i]);
-        stats.trace_seconds +=
-            timed([&] { trace_batch(structure, batch.data(), batch_hits.data(), batch.size(), any_hit, &stats.ls); });
+        stats.trace_seconds += timed([&] { trace_batch(structure, batch.data(), batch_hits.data(), kept, any_hit, &stats.ls); });
+        if (kept < active.size()) {
+          lsk::LsCounters counters{};
+          const double seconds = timed([&] {
+            trace_batch(*switched.accel, batch.data() + kept, batch_hits.data() + kept, active.size() - kept, any_hit, &counters);
+          });
+          add_switched(stats, counters, seconds);
+          switched_rays += active.size() - kept;
+        }
         return uint64_t(active.size());
       };
 
+      // Decide which paths switch structure at this bounce (the kernel's rule, as on the GPU).
+      if (switched.accel)
+        tbb::parallel_for(size_t(0), order.size(), [&](size_t i) {
+          lsk::PathState& path = paths[order[i]];
+          if (path.alive != 0) path.switched = lsk::throughput_switched(path.throughput, switched.threshold);
+        });
       // Trace the extension rays of this bounce (the camera rays at bounce 0).
       stats.extension_rays += trace_selected([&](uint32_t p) { return paths[p].alive != 0; },
-                                             [&](uint32_t p) { return paths[p].ray; }, false);
+                                             [&](uint32_t p) { return paths[p].ray; }, false, stats.switched_extension_rays);
       if (active.empty()) break;
 
       // Shade: emission found, a light sample for next-event estimation, the next direction.
@@ -182,7 +257,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
 
       // Trace this bounce's shadow rays (any hit) and add the light they let through.
       stats.shadow_rays += trace_selected([&](uint32_t p) { return paths[p].has_shadow != 0; },
-                                          [&](uint32_t p) { return paths[p].shadow_ray; }, true);
+                                          [&](uint32_t p) { return paths[p].shadow_ray; }, true, stats.switched_shadow_rays);
       tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
         const uint32_t p = active[i];

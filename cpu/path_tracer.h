@@ -20,6 +20,7 @@
 #include "shade_context.h"
 #include "structure_name.h"
 #include "surface.h"
+#include "throughput_switch.h"
 
 #include <functional>
 #include <map>
@@ -35,7 +36,17 @@ struct RenderOptions {
   uint32_t width = 512;
   uint32_t height = 512;
   uint32_t seed = 1;
+  // The pixels to render, row-major indices in ascending order (a sharded render's tiles:
+  // tile_selection.h); empty: every pixel.  The others stay black and trace no ray.  Random numbers are
+  // keyed by the global pixel index, so a rendered pixel's value does not depend on which others are.
+  std::vector<uint32_t> pixels;
+  // Paths whose throughput is below a threshold trace a bounce's rays with another structure
+  // (throughput_switch.h); off by default.
+  ThroughputSwitch throughput_switch;
 };
+
+// options.pixels, or every pixel when it is empty; throws InputError unless ascending and in the image.
+std::vector<uint32_t> render_pixels(const RenderOptions& options);
 
 struct BounceStats {
   uint64_t extension_rays = 0;  // camera rays at bounce 0
@@ -43,6 +54,11 @@ struct BounceStats {
   double trace_seconds = 0.0;   // wall-clock time spent inside trace batches
   std::string structure;
   lsk::LsCounters ls{};         // Line Space lookups of this bounce's rays
+  // The part of the above traced with the throughput switch's structure (all zero when it is off).
+  uint64_t switched_extension_rays = 0;
+  uint64_t switched_shadow_rays = 0;
+  double switched_seconds = 0.0;
+  lsk::LsCounters switched_ls{};
 };
 
 struct RenderResult {
@@ -83,13 +99,18 @@ lsk::ShadeContext shade_context(const SurfaceLookup& surfaces, const LightSet& l
 // the float range; each clamped pixel counts as a dropped sample).
 void average_passes(RenderResult& result, int spp);
 
-// structures: built structures keyed by canonical name; every schedule entry must be present.
+// structures: built structures keyed by canonical name; every schedule entry (and the throughput
+// switch's structure, when it is on) must be present.
 // tracer: where the batches are traced (empty: trace_rays on all CPU threads).
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
                     const Progress& progress = {}, const BatchTracer& tracer = {});
 
-// Builds each distinct structure of the schedule once.
+// Builds each distinct structure of the schedule once (and the throughput switch's, when given and on).
 std::map<std::string, Accel> build_schedule_structures(const Scene& scene, const Schedule& schedule,
-                                                       const AccelOptions& options = {});
+                                                       const AccelOptions& options = {},
+                                                       const ThroughputSwitch& throughput_switch = {});
+
+// The structures a render needs: each distinct schedule entry up to `bounces`, and the switch's.
+std::vector<StructureSpec> render_structures(const RenderOptions& options);
 
 }  // namespace ls

@@ -168,7 +168,9 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
 
   // The schedule's distinct structures, in schedule order; the two-level ones built once, here.
   std::vector<StructureSpec> distinct;
-  for (const StructureSpec& spec : options.schedule.per_bounce)
+  std::vector<StructureSpec> used = options.schedule.per_bounce;
+  if (options.throughput_switch.enabled()) used.push_back(options.throughput_switch.structure);  // --throughput-switch's too
+  for (const StructureSpec& spec : used)
     if (std::find(distinct.begin(), distinct.end(), spec) == distinct.end()) distinct.push_back(spec);
   std::map<std::string, Accel> built;
   json initial = json::array();
@@ -282,7 +284,8 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
                  {"indirect_rays", result.indirect_rays()},
                  {"indirect_seconds", result.indirect_seconds()},
                  {"indirect_mrays_per_s", result.indirect_mrays_per_s()}};
-      RenderReportContext ctx{scene_spec, options.schedule.name(), options.spp, options.seed, &built, device, frame};
+      RenderReportContext ctx{scene_spec, options.schedule.name(), options.spp, options.seed, &built, device, frame,
+                              options.throughput_switch};
       // A whole frame or none: written aside, renamed when complete.
       const fs::path partial = out / (name + ".partial"), final_dir = out / name;
       fs::remove_all(partial);

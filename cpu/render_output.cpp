@@ -11,27 +11,57 @@
 
 namespace ls {
 
+namespace {
+
+// The report's name of each Line Space counter (after a prefix such as "ls_").
+struct CounterKey {
+  const char* name;
+  uint32_t lsk::LsCounters::*field;
+};
+constexpr CounterKey kCounterKeys[] = {
+    {"lookups", &lsk::LsCounters::lookups},
+    {"empty", &lsk::LsCounters::empty},
+    {"accepted", &lsk::LsCounters::accepted},
+    {"refused_angle", &lsk::LsCounters::refused_angle},
+    {"refused_behind", &lsk::LsCounters::refused_behind},
+    {"refused_beyond", &lsk::LsCounters::refused_beyond},
+    {"refused_parallel", &lsk::LsCounters::refused_parallel},
+    {"refused_no_shaft", &lsk::LsCounters::refused_no_shaft},
+};
+
+}  // namespace
+
+void put_ls_counters(nlohmann::json& into, const std::string& prefix, const lsk::LsCounters& c) {
+  for (const CounterKey& k : kCounterKeys) into[prefix + k.name] = c.*k.field;
+}
+
+lsk::LsCounters get_ls_counters(const nlohmann::json& from, const std::string& prefix) {
+  lsk::LsCounters c{};
+  for (const CounterKey& k : kCounterKeys) c.*k.field = from.at(prefix + k.name).get<uint32_t>();
+  return c;
+}
+
 nlohmann::json render_report(const RenderResult& result, const RenderReportContext& context) {
   using nlohmann::json;
   json per_bounce = json::array();
   for (size_t k = 0; k < result.bounces.size(); ++k) {
     const BounceStats& b = result.bounces[k];
     const uint64_t rays = b.extension_rays + b.shadow_rays;
-    per_bounce.push_back({{"bounce", k},
-                          {"structure", b.structure},
-                          {"extension_rays", b.extension_rays},
-                          {"shadow_rays", b.shadow_rays},
-                          {"rays", rays},
-                          {"seconds", b.trace_seconds},
-                          {"ls_lookups", b.ls.lookups},
-                          {"ls_empty", b.ls.empty},
-                          {"ls_accepted", b.ls.accepted},
-                          {"ls_refused_angle", b.ls.refused_angle},
-                          {"ls_refused_behind", b.ls.refused_behind},
-                          {"ls_refused_beyond", b.ls.refused_beyond},
-                          {"ls_refused_parallel", b.ls.refused_parallel},
-                          {"ls_refused_no_shaft", b.ls.refused_no_shaft},
-                          {"mrays_per_s", b.trace_seconds > 0.0 ? double(rays) / b.trace_seconds * 1e-6 : 0.0}});
+    json entry{{"bounce", k},
+               {"structure", b.structure},
+               {"extension_rays", b.extension_rays},
+               {"shadow_rays", b.shadow_rays},
+               {"rays", rays},
+               {"seconds", b.trace_seconds}};
+    put_ls_counters(entry, "ls_", b.ls);
+    entry["mrays_per_s"] = b.trace_seconds > 0.0 ? double(rays) / b.trace_seconds * 1e-6 : 0.0;
+    // The part of the above that the throughput switch traced with its structure.
+    entry["switched_extension_rays"] = b.switched_extension_rays;
+    entry["switched_shadow_rays"] = b.switched_shadow_rays;
+    entry["switched_rays"] = b.switched_extension_rays + b.switched_shadow_rays;
+    entry["switched_seconds"] = b.switched_seconds;
+    put_ls_counters(entry, "switched_ls_", b.switched_ls);
+    per_bounce.push_back(entry);
   }
   json structures = json::array();
   if (context.structures)
@@ -60,15 +90,23 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
                 {"mrays_per_s", result.indirect_mrays_per_s()}}},
               {"per_bounce", per_bounce},
               {"structures", structures},
-              {"dropped_samples", result.dropped_samples}};
+              {"dropped_samples", result.dropped_samples},
+              {"throughput_switch", context.throughput_switch.enabled()
+                                        ? json{{"threshold", std::stod(shortest_text(context.throughput_switch.threshold))},
+                                               {"structure", context.throughput_switch.structure.name()}}
+                                        : json(nullptr)}};
   if (!context.frame.is_null()) report["frame"] = context.frame;
   return report;
 }
 
-nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context) {
+void create_output_folder(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError("cannot create output folder '" + dir + "': " + ec.message());
+}
+
+void write_render_images(const std::string& dir, const RenderResult& result) {
+  create_output_folder(dir);
   const std::filesystem::path out(dir);
   Image image{result.width, result.height, result.total};
   write_exr((out / "total.exr").string(), image);
@@ -76,8 +114,17 @@ nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& 
   for (size_t k = 0; k < result.bounce_images.size(); ++k)
     write_exr((out / ("bounce_" + std::to_string(k) + ".exr")).string(),
               Image{result.width, result.height, result.bounce_images[k]});
+}
+
+nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context) {
+  write_render_images(dir, result);
   nlohmann::json report = render_report(result, context);
-  const std::string path = (out / "report.json").string(), temp = path + ".partial";
+  write_json_file((std::filesystem::path(dir) / "report.json").string(), report);
+  return report;
+}
+
+void write_json_file(const std::string& path, const nlohmann::json& report) {
+  const std::string temp = path + ".partial";
   throw_if_interrupted();
   set_partial_file(&temp);
   {
@@ -92,7 +139,6 @@ nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& 
   }
   std::filesystem::rename(temp, path);
   set_partial_file(nullptr);
-  return report;
 }
 
 }  // namespace ls

@@ -17,10 +17,21 @@ struct RenderReportContext {
   const std::map<std::string, Accel>* structures = nullptr;
   std::string device;  // who traced: empty for this CPU ("cpu: MODEL" in the report)
   nlohmann::json frame;  // render --frames: this frame's index, time and updates (key "frame"); null: none
+  ThroughputSwitch throughput_switch;  // off: the report's "throughput_switch" is null
 };
 
 nlohmann::json render_report(const RenderResult& result, const RenderReportContext& context);
 // Writes every file into `dir` (created if missing); returns the report that was written.
 nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context);
+
+// The parts of write_render_outputs: the folder, the images (total.exr, bounce_K.exr, image.png) and
+// a JSON file, each written to a temporary name and renamed (interrupt.h).
+void create_output_folder(const std::string& dir);
+void write_render_images(const std::string& dir, const RenderResult& result);
+void write_json_file(const std::string& path, const nlohmann::json& json);
+
+// Line Space counters as report keys: prefix + lookups, empty, accepted, refused_angle, ...
+void put_ls_counters(nlohmann::json& into, const std::string& prefix, const lsk::LsCounters& counters);
+lsk::LsCounters get_ls_counters(const nlohmann::json& from, const std::string& prefix);  // throws json errors
 
 }  // namespace ls

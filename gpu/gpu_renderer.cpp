@@ -22,7 +22,9 @@ struct ShadePush {
   uint32_t bounce = 0;
   uint32_t count = 0;
   uint32_t image_offset = 0;
-  uint32_t pad[3] = {0, 0, 0};
+  uint32_t list_kind = 0;         // mode 3: 0 extension rays (decide), 1 shadow rays (as decided)
+  float switch_threshold = 0.0f;  // mode 3: the throughput switch's T
+  uint32_t pad = 0;
 };
 static_assert(sizeof(ShadePush) == 32, "must match the GLSL push-constant block");
 
@@ -92,6 +94,8 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
   constants.shade = shading.shade;
   constants.cam = camera_frame(scene.camera, options.width, options.height);
   const Buffer constant_buffer = make_buffer(context, std::vector<ShadeConstants>{constants}, "constants");
+  const std::vector<uint32_t> order = render_pixels(options);  // the pixels this render computes
+  const Buffer selection = make_buffer(context, order, "selection");
   const Buffer paths(context, size_t(pixels) * sizeof(lsk::PathState), "paths");
   Buffer images(context, size_t(bounces + 1) * pixels * 3 * sizeof(float), "images");
   Buffer dropped(context, size_t(pixels) * sizeof(uint32_t), "dropped");
@@ -102,12 +106,14 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
 
   ComputePipeline shade(context, spirv_shade(), 17, sizeof(ShadePush));
   GpuTracer tracer(context);
-  // One shade.comp step over `count` entries of `batch` (its pixels and hits), appending to next/shadow.
-  auto run_shade = [&](ShadePush push, const RayList& batch, RayList& out_next) {
+  // One shade.comp step over `count` entries of a batch (its pixels and hits), appending to the two
+  // output lists (next segments and shadow rays; mode 3: the schedule's and the switched rays).
+  auto run_shade = [&](ShadePush push, const Buffer& batch_pixels, const Buffer& batch_hits, RayList& out_next,
+                       RayList& out_shadow) {
     if (push.count == 0) return;
     shade.bind({&instances, &vertices, &triangles, &materials, &light_buffer, &cdf, &constant_buffer, &paths, &images,
-                &dropped, &batch.pixels, &batch.hits, &out_next.rays, &out_next.pixels, &shadow.rays, &shadow.pixels,
-                &counts});
+                &dropped, &batch_pixels, &batch_hits, &out_next.rays, &out_next.pixels, &out_shadow.rays,
+                &out_shadow.pixels, &counts});
     context.submit_and_wait([&](VkCommandBuffer cmd) { shade.record(cmd, &push, (push.count + kGroup - 1) / kGroup); });
   };
   // Traces a list on the GPU, timed by timestamps around the trace dispatches (wall time without them).
@@ -119,35 +125,88 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
                          &timing);
     stats.trace_seconds += timing.kernel_seconds > 0.0 ? timing.kernel_seconds : timing.wall_seconds;
   };
+  // The throughput switch (throughput_switch.h): its structure and the two lists a ray list splits into.
+  const ThroughputSwitch& policy = options.throughput_switch;
+  std::unique_ptr<GpuAccel> switch_accel;
+  std::unique_ptr<RayList> kept, switched;
+  if (policy.enabled()) {
+    const auto it = structures.find(policy.structure.name());
+    if (it == structures.end()) throw InputError("render: structure '" + policy.structure.name() + "' was not built");
+    switch_accel = std::make_unique<GpuAccel>(context, it->second);
+    kept = std::make_unique<RayList>(context, pixels);
+    switched = std::make_unique<RayList>(context, pixels);
+  }
+  auto trace_switched = [&](int k, const RayList& list, uint32_t count, bool any_hit) {
+    if (count == 0) return;
+    BounceStats& stats = result.bounces[size_t(k)];
+    GpuTraceTiming timing;
+    lsk::LsCounters counters{};
+    tracer.trace_buffers(*switch_accel, list.rays, list.hits, count, any_hit, policy.structure.line_space() ? &counters : nullptr,
+                         &timing);
+    const double seconds = timing.kernel_seconds > 0.0 ? timing.kernel_seconds : timing.wall_seconds;
+    stats.trace_seconds += seconds;
+    stats.switched_seconds += seconds;
+    add_counters(stats.ls, counters);
+    add_counters(stats.switched_ls, counters);
+    (any_hit ? stats.switched_shadow_rays : stats.switched_extension_rays) += count;
+  };
+  // Traces a list of bounce k's rays and returns the lists to shade: itself, or with the switch on its
+  // split (shade.comp mode 3, the kernel's decision) into the schedule's rays and the switched ones.
+  struct Group {
+    const RayList* list;
+    uint32_t count;
+  };
+  auto trace_groups = [&](int k, const RayList& list, uint32_t count, bool any_hit) -> std::vector<Group> {
+    if (!policy.enabled()) {
+      trace_list(k, list, count, any_hit);
+      return {{&list, count}};
+    }
+    const uint32_t zero[2] = {0, 0};
+    counts.upload(zero, sizeof(zero));
+    ShadePush split;
+    split.mode = 3;
+    split.count = count;
+    split.list_kind = any_hit ? 1u : 0u;
+    split.switch_threshold = policy.threshold;
+    run_shade(split, list.pixels, list.hits, *kept, *switched);
+    uint32_t got[2];
+    counts.download(got, sizeof(got));
+    trace_list(k, *kept, got[0], any_hit);
+    trace_switched(k, *switched, got[1], any_hit);
+    return {{kept.get(), got[0]}, {switched.get(), got[1]}};
+  };
 
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces, like the CPU renderer
     ShadePush push;
     push.sample_index = uint32_t(s);
     push.mode = 0;
-    push.count = pixels;
-    run_shade(push, extension, extension);  // writes the camera rays into extension's list
-    uint32_t extension_count = pixels;
+    push.count = uint32_t(order.size());
+    run_shade(push, selection, extension.hits, extension, shadow);  // the selected pixels' camera rays into extension's list
+    uint32_t extension_count = push.count;
     for (int k = 0; k <= bounces; ++k) {
       throw_if_interrupted();
       BounceStats& stats = result.bounces[size_t(k)];
       stats.extension_rays += extension_count;
       if (extension_count == 0) break;
-      trace_list(k, extension, extension_count, false);
+      const std::vector<Group> traced = trace_groups(k, extension, extension_count, false);
       const uint32_t zero[2] = {0, 0};
       counts.upload(zero, sizeof(zero));
       push.mode = 1;
       push.bounce = uint32_t(k);
-      push.count = extension_count;
       push.image_offset = uint32_t(k) * pixels * 3;
-      run_shade(push, extension, next);
+      for (const Group& g : traced) {
+        push.count = g.count;
+        run_shade(push, g.list->pixels, g.list->hits, next, shadow);
+      }
       uint32_t got[2];
       counts.download(got, sizeof(got));
       stats.shadow_rays += got[1];
-      trace_list(k, shadow, got[1], true);
       push.mode = 2;
-      push.count = got[1];
-      run_shade(push, shadow, next);
+      for (const Group& g : trace_groups(k, shadow, got[1], true)) {
+        push.count = g.count;
+        run_shade(push, g.list->pixels, g.list->hits, next, shadow);
+      }
       std::swap(extension, next);
       extension_count = got[0];
     }

@@ -63,7 +63,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 20> cases = {
+  const std::array<std::string, 25> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -76,6 +76,11 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "render --size 0x10 --out " + temp("r").string(),
       "render --size banana --out " + temp("r").string(),
       "render --spp 0 --size 8x8 --out " + temp("r").string(),
+      "render --throughput-switch 0:bvh --size 8x8 --out " + temp("r").string(),
+      "render --throughput-switch -0.5:bvh --size 8x8 --out " + temp("r").string(),
+      "render --throughput-switch nan:bvh --size 8x8 --out " + temp("r").string(),
+      "render --throughput-switch 0.5:octree --size 8x8 --out " + temp("r").string(),
+      "render --throughput-switch 0.5 --size 8x8 --out " + temp("r").string(),
       "trace --rays " + temp("odd.rays").string() + " --hits " + temp("h").string(),
       "trace --rays /nonexistent.rays --hits " + temp("h").string(),
       "rays --kind sideways --count 10 --out " + temp("x.rays").string(),

@@ -8,6 +8,7 @@
 #include "path_tracer.h"
 #include "ray_generators.h"
 #include "top_level_update.h"
+#include "tile_selection.h"
 
 #include <catch2/catch.hpp>
 
@@ -296,4 +297,64 @@ TEST_CASE("GPU frames with top-level-only updates equal the CPU's bit for bit", 
     for (const glm::vec3& p : g.total) sum += p.x + p.y + p.z;
     REQUIRE(sum > 0.0f);
   }
+}
+
+TEST_CASE("a GPU render of some tiles gives the CPU single render's pixels there bit for bit, black elsewhere", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  RenderOptions options;
+  options.schedule = parse_schedule("bvh,2l-ls:2:6");
+  options.width = 37;
+  options.height = 21;
+  options.spp = 2;
+  options.bounces = 2;
+  options.seed = 3;
+  const std::map<std::string, Accel> cpu_built = build_schedule_structures(cornell, options.schedule);
+  const std::map<std::string, Accel> gpu_built = gpu::build_schedule_structures_gpu(device(), cornell, options.schedule);
+  const RenderResult single = render(cornell, cpu_built, options);
+  const TileGrid grid{options.width, options.height, 8};
+  RenderOptions shard = options;
+  shard.pixels = tile_pixels(grid, parse_shard("1/3", grid));
+  const RenderResult gpu = gpu::render_gpu(device(), cornell, gpu_built, shard);
+  std::vector<char> mine(single.total.size(), 0);
+  for (uint32_t p : shard.pixels) mine[p] = 1;
+  const glm::vec3 zero(0.0f);
+  for (size_t p = 0; p < mine.size(); ++p) {
+    INFO("pixel " << p);
+    REQUIRE(std::memcmp(&gpu.total[p], mine[p] ? &single.total[p] : &zero, sizeof(glm::vec3)) == 0);
+    for (size_t k = 0; k < gpu.bounce_images.size(); ++k)
+      REQUIRE(std::memcmp(&gpu.bounce_images[k][p], mine[p] ? &single.bounce_images[k][p] : &zero, sizeof(glm::vec3)) == 0);
+  }
+  REQUIRE(gpu.bounces[0].extension_rays == shard.pixels.size() * size_t(shard.spp));  // camera rays of its pixels only
+}
+
+TEST_CASE("a GPU render with the throughput switch gives the CPU's images, counts and decisions bit for bit", "[gpu]") {
+  const Scene cornell = load_scene("builtin:cornell");
+  RenderOptions options;
+  options.schedule = parse_schedule("bvh,f-ls:3:6");
+  options.throughput_switch = parse_throughput_switch("0.35:2l-ls:2:6");
+  options.width = 40;
+  options.height = 28;
+  options.spp = 2;
+  options.bounces = 3;
+  options.seed = 9;
+  const auto cpu_built = build_schedule_structures(cornell, options.schedule, paper(), options.throughput_switch);
+  std::map<std::string, Accel> gpu_built;
+  for (const StructureSpec& spec : render_structures(options))
+    gpu_built.emplace(spec.name(), gpu::build_accel_gpu(device(), cornell, spec, paper()));
+  const RenderResult cpu = render(cornell, cpu_built, options);
+  const RenderResult gpu = gpu::render_gpu(device(), cornell, gpu_built, options);
+  uint64_t switched = 0;
+  for (size_t k = 0; k < cpu.bounce_images.size(); ++k) {
+    INFO("bounce " << k);
+    REQUIRE(cpu.bounces[k].extension_rays == gpu.bounces[k].extension_rays);
+    REQUIRE(cpu.bounces[k].shadow_rays == gpu.bounces[k].shadow_rays);
+    REQUIRE(cpu.bounces[k].switched_extension_rays == gpu.bounces[k].switched_extension_rays);
+    REQUIRE(cpu.bounces[k].switched_shadow_rays == gpu.bounces[k].switched_shadow_rays);
+    REQUIRE(std::memcmp(&cpu.bounces[k].ls, &gpu.bounces[k].ls, sizeof(lsk::LsCounters)) == 0);
+    REQUIRE(std::memcmp(&cpu.bounces[k].switched_ls, &gpu.bounces[k].switched_ls, sizeof(lsk::LsCounters)) == 0);
+    REQUIRE(std::memcmp(cpu.bounce_images[k].data(), gpu.bounce_images[k].data(), cpu.bounce_images[k].size() * sizeof(glm::vec3)) == 0);
+    switched += cpu.bounces[k].switched_extension_rays;
+  }
+  REQUIRE(switched > 0);  // the switch was in play
+  REQUIRE(cpu.bounces[2].switched_ls.lookups > 0);
 }

@@ -1,6 +1,7 @@
 // linespace-gpu end to end: bad input exits 2 with a one-line reason (no device or a wrong --device
 // included), and its hit files, build report and render equal linespace-cpu's.
 #include "image_output.h"
+#include "shard_files.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -166,4 +167,48 @@ TEST_CASE("linespace-gpu render --frames writes the frames linespace-cpu writes,
   CHECK(jg["frames_done"] == 3);
   CHECK(jg["device"] != jc["device"]);
   for (size_t i = 0; i < 3; ++i) CHECK(jg["frames"][i]["indirect_rays"] == jc["frames"][i]["indirect_rays"]);
+}
+
+TEST_CASE("linespace-gpu shards merged, alone or with a CPU shard, equal linespace-cpu's single render", "[gpu_cli]") {
+  using test_support::require_same_render;
+  const std::string args = "render --scene builtin:cornell --size 45x29 --spp 2 --bounces 2 --schedule bvh,f-ls:3:6,2l-ls:2:6 "
+                           "--tile-size 8 --quiet ";
+  fs::remove_all(temp("shards"));
+  REQUIRE(run(LINESPACE_CPU, args + "--out " + temp("shards/single").string()).status == 0);
+  for (int k = 0; k < 3; ++k) {
+    const Run g = run(LINESPACE_GPU, args + "--shard " + std::to_string(k) + "/3 --out " + temp("shards/gpu").string());
+    INFO(g.err);
+    REQUIRE(g.status == 0);
+  }
+  REQUIRE(run(LINESPACE_CPU, args + "--shard 0/3 --out " + temp("shards/cpu").string()).status == 0);
+  const std::string gpu = temp("shards/gpu").string() + "/partial-shard-";
+  Run m = run(LINESPACE_GPU, "merge --out " + temp("shards/merged_gpu").string() + " " + gpu + "0-of-3.exr " + gpu +
+                                 "1-of-3.exr " + gpu + "2-of-3.exr");
+  INFO(m.err);
+  REQUIRE(m.status == 0);
+  require_same_render(temp("shards/single"), temp("shards/merged_gpu"), 3);
+  m = run(LINESPACE_CPU, "merge --out " + temp("shards/merged_mixed").string() + " " + temp("shards/cpu").string() +
+                             "/partial-shard-0-of-3.exr " + gpu + "1-of-3.exr " + gpu + "2-of-3.exr");
+  INFO(m.err);
+  REQUIRE(m.status == 0);
+  require_same_render(temp("shards/single"), temp("shards/merged_mixed"), 3);
+  const auto report = nlohmann::json::parse(slurp(temp("shards/merged_mixed/report.json")));
+  CHECK(report.at("device").get<std::string>().find("; ") != std::string::npos);  // both devices named
+}
+
+TEST_CASE("linespace-validate policy on the GPU gives the CPU's RMSE and rays on X", "[gpu_cli]") {
+  const std::string args = "policy --size 24x16 --spp 1 --bounces 2 --structure f-ls:3:6 --thresholds 0.3,0.6 --out ";
+  REQUIRE(run(LINESPACE_VALIDATE, args + temp("policy_cpu").string() + " --device cpu").status == 0);
+  const Run g = run(LINESPACE_VALIDATE, args + temp("policy_gpu").string() + " --device gpu");
+  INFO(g.err);
+  REQUIRE(g.status == 0);
+  const auto cpu = nlohmann::json::parse(slurp(temp("policy_cpu") / "policy.json")).at("points");
+  const auto gpu = nlohmann::json::parse(slurp(temp("policy_gpu") / "policy.json")).at("points");
+  REQUIRE(cpu.size() == 4u);
+  REQUIRE(cpu.size() == gpu.size());
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    CHECK(cpu[i].at("rmse") == gpu[i].at("rmse"));  // the same images
+    CHECK(cpu[i].at("rays_on_x") == gpu[i].at("rays_on_x"));  // the same decisions
+    CHECK(cpu[i].at("indirect_rays") == gpu[i].at("indirect_rays"));
+  }
 }

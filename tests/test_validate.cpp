@@ -4,11 +4,14 @@
 #include "heatmap.h"
 #include "image_metrics.h"
 #include "load_scene.h"
+#include "policy_study.h"
 #include "rmse_study.h"
 #include "sweep.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 using namespace ls;
@@ -137,4 +140,70 @@ TEST_CASE("list flags of the validator reject nonsense", "[validate]") {
   REQUIRE_THROWS_AS(parse_angle_list("91"), InputError);
   REQUIRE_THROWS_AS(parse_angle_list("nan"), InputError);
   REQUIRE_THROWS_AS(parse_families("f-ls,bvh"), InputError);
+}
+
+TEST_CASE("interpolation on the policy curves: linear between neighbours, none outside", "[validate]") {
+  const std::vector<std::pair<double, double>> points = {{1.0, 3.0}, {0.0, 0.0}, {0.5, 1.0}};  // unsorted on purpose
+  REQUIRE(interpolate(points, 0.25) == Approx(0.5));
+  REQUIRE(interpolate(points, 0.75) == Approx(2.0));
+  REQUIRE(interpolate(points, 0.5) == 1.0);
+  REQUIRE(interpolate(points, 1.0) == 3.0);
+  REQUIRE(interpolate(points, 0.0) == 0.0);
+  REQUIRE(std::isnan(interpolate(points, 1.01)));
+  REQUIRE(std::isnan(interpolate(points, -0.01)));
+  REQUIRE(std::isnan(interpolate({}, 0.0)));
+  REQUIRE(interpolate({{0.0, 1.0}, {0.0, 5.0}, {1.0, 2.0}}, 0.0) == 1.0);  // equal x: the first given
+  REQUIRE(parse_threshold_list("0.3,0.1,0.3") == std::vector<float>{0.1f, 0.3f});
+  for (const char* bad : {"0", "-1", "nan", "inf", "0.1,", ",0.1", "x", ""}) REQUIRE_THROWS_AS(parse_threshold_list(bad), InputError);
+}
+
+TEST_CASE("the policy study's RMSE and rays on X equal a direct computation from the renders", "[validate]") {
+  const Scene scene = load_scene("builtin:cornell");
+  AccelOptions options;
+  options.ls.min_triangles = 0;
+  CpuStudyRenderer renderer(scene, options);
+  const ImageSettings settings = tiny_image();
+  const StructureSpec x = parse_structure("f-ls:3:6");
+  const PolicyStudy study = run_policy_study(renderer, "builtin:cornell", x, {1, 3}, {0.3f, 0.6f}, settings, quiet);
+  REQUIRE(study.points.size() == 4);
+  const RenderResult reference = renderer.render(settings.options(parse_schedule("bvh")));
+  const float e = exposure_scale(reference.total);
+  auto indirect = [](const RenderResult& r, int from) {
+    uint64_t n = 0;
+    for (size_t k = size_t(from); k < r.bounces.size(); ++k) n += r.bounces[k].extension_rays + r.bounces[k].shadow_rays;
+    return n;
+  };
+  for (const PolicyPoint& p : study.points) {
+    INFO(p.policy << " " << p.label());
+    RenderOptions o = settings.options(p.policy == "bounce" ? schedule_from(x, p.start_bounce) : parse_schedule("bvh"));
+    if (p.policy == "throughput") o.throughput_switch = ThroughputSwitch{p.threshold, x};
+    const RenderResult r = renderer.render(o);
+    REQUIRE(p.rmse == rmse(reference.total, r.total, e));
+    REQUIRE(p.rmse > 0.0);
+    REQUIRE(p.indirect_rays == indirect(r, 1));
+    if (p.policy == "bounce") {
+      REQUIRE(p.rays_on_x == indirect(r, p.start_bounce));  // every ray from the start bounce on
+    } else {
+      uint64_t switched = 0;
+      for (size_t k = 1; k < r.bounces.size(); ++k) switched += r.bounces[k].switched_extension_rays + r.bounces[k].switched_shadow_rays;
+      REQUIRE(p.rays_on_x == switched);
+      REQUIRE(r.bounces[0].switched_extension_rays == 0);  // T <= 1: camera rays stay exact
+    }
+  }
+  // Each comparison interpolates the throughput points (and the reference at 0) at the bounce point's fraction.
+  REQUIRE(study.comparisons.size() == 2);
+  for (const PolicyComparison& c : study.comparisons) {
+    std::vector<std::pair<double, double>> curve = {{0.0, 0.0}};
+    for (const PolicyPoint& p : study.points)
+      if (p.policy == "throughput") curve.push_back({p.fraction_on_x(), p.rmse});
+    std::sort(curve.begin(), curve.end());
+    double expected = std::nan("");
+    for (size_t i = 0; i + 1 < curve.size(); ++i)
+      if (curve[i].first <= c.fraction_on_x && c.fraction_on_x <= curve[i + 1].first)
+        expected = curve[i].second + (curve[i + 1].second - curve[i].second) * (c.fraction_on_x - curve[i].first) /
+                                         (curve[i + 1].first - curve[i].first);
+    INFO("from bounce " << c.start_bounce << " at " << c.fraction_on_x);
+    if (std::isnan(expected)) REQUIRE(std::isnan(c.throughput_rmse_at_fraction));
+    else REQUIRE(c.throughput_rmse_at_fraction == Approx(expected));
+  }
 }

@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 14> cases = {
+  const std::array<std::string, 22> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -36,6 +36,14 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "sweep --start-bounce 5 --bounces 3",
       "paper --tables 5",
       "paper --subdivisions 7",
+      "policy --thresholds 0",
+      "policy --thresholds -0.5",
+      "policy --thresholds nan",
+      "policy --thresholds 0.1,",
+      "policy --start-bounces 0",
+      "policy --start-bounces 4 --bounces 3",
+      "policy --structure octree",
+      "policy --repeat 0",
   };
   for (const std::string& c : cases) {
     INFO(c);
@@ -106,4 +114,27 @@ TEST_CASE("linespace-validate paper prints the three tables and the claims", "[c
   REQUIRE(t4[0]["rmse"] == 0.0);  // the all-exact schedule against itself
   REQUIRE(j["claims"].size() >= 6);
   for (const auto& c : j["claims"]) REQUIRE(c["checked"].get<int>() >= c["held"].get<int>());
+}
+
+TEST_CASE("linespace-validate policy writes policy.{md,csv,json} with both policies and the equal-speed comparison", "[cli]") {
+  const fs::path out = temp("policy");
+  const Run r = validate("policy --scene builtin:cornell --structure f-ls:3:6 --thresholds 0.3,2 --start-bounces 2 --repeat 2 "
+                         "--size 16x16 --spp 1 --bounces 2 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "policy.json"));
+  REQUIRE(j["structure"] == "f-ls:3:6");
+  REQUIRE(j["repeats"] == 2);
+  REQUIRE(j["points"].size() == 3);
+  for (const auto& p : j["points"]) {
+    for (const char* key : {"policy", "rmse", "mrays_per_s", "fraction_on_x", "rays_on_x", "indirect_rays"}) REQUIRE(p.contains(key));
+    REQUIRE(p["fraction_on_x"].get<double>() == double(p["rays_on_x"].get<uint64_t>()) / double(p["indirect_rays"].get<uint64_t>()));
+  }
+  // T = 2 is above every throughput: every indirect ray on X.
+  REQUIRE(j["points"][2]["threshold"] == 2.0);
+  REQUIRE(j["points"][2]["fraction_on_x"] == 1.0);
+  REQUIRE(j["comparisons"].size() == 1);
+  REQUIRE(j["comparisons"][0]["start_bounce"] == 2);
+  REQUIRE(fs::file_size(out / "policy.md") > 0);
+  REQUIRE(fs::file_size(out / "policy.csv") > 0);
 }

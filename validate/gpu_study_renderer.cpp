@@ -17,7 +17,7 @@ const Accel& GpuStudyRenderer::structure(const StructureSpec& spec) {
 }
 
 RenderResult GpuStudyRenderer::render(const RenderOptions& options) {
-  for (int k = 0; k <= options.bounces; ++k) structure(options.schedule.at(k));
+  for (const StructureSpec& spec : render_structures(options)) structure(spec);  // the switch's too
   return gpu::render_gpu(*context_, scene_, built_, options);
 }
 

@@ -6,6 +6,7 @@
 #include "cross_check.h"
 #include "load_scene.h"
 #include "paper_tables.h"
+#include "policy_study.h"
 #include "rmse_study.h"
 #include "sweep.h"
 
@@ -131,6 +132,19 @@ int main(int argc, char** argv) {
   budget_cmd->add_option("--out", out_dir, "folder for budget.{md,csv,json}")->default_val("out/budget");
   image_flags.add_to(budget_cmd);
   ls_flags.add_to(budget_cmd);
+  std::string policy_structure = "f-ls:8:6", thresholds = "0.05,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.99", start_bounces;
+  int policy_repeats = 1;
+  auto* policy_cmd = app.add_subcommand("policy", "bounce policy against throughput policy (render --throughput-switch) at equal speed");
+  policy_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
+  policy_cmd->add_option("--structure", policy_structure, "the approximate structure X both policies switch to")->capture_default_str();
+  policy_cmd->add_option("--thresholds", thresholds, "throughput policy: X below these throughput luminances")->capture_default_str();
+  policy_cmd->add_option("--start-bounces", start_bounces, "bounce policy: X from these bounces on (default 1..--bounces)");
+  policy_cmd->add_option("--repeat", policy_repeats, "timed renders per configuration, round-robin (median MRays/s)")
+      ->capture_default_str()->check(CLI::Range(1, 100));
+  policy_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
+  policy_cmd->add_option("--out", out_dir, "folder for policy.{md,csv,json}")->default_val("out/policy");
+  image_flags.add_to(policy_cmd);
+  ls_flags.add_to(policy_cmd);
 
   // CPU-versus-GPU cross-checks (issue 5): exit 1 on any difference.
   validate::CrossCheckCommand check;
@@ -206,6 +220,22 @@ int main(int argc, char** argv) {
       std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\n%s\nwrote %s/{budget.md, budget.csv, budget.json}\n", scene_spec.c_str(),
                   settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
                   study.table().markdown().c_str(), study.choices().markdown().c_str(), out_dir.c_str());
+    } else if (*policy_cmd) {
+      const StructureSpec spec = parse_structure(policy_structure);
+      const ImageSettings settings = image_flags.settings();
+      std::vector<int> starts;
+      if (start_bounces.empty())
+        for (int k = 1; k <= settings.bounces; ++k) starts.push_back(k);
+      else
+        starts = parse_int_list(start_bounces, "--start-bounces", 1, settings.bounces);
+      const std::vector<float> ts = parse_threshold_list(thresholds);
+      const Scene scene = load_scene(scene_spec);
+      auto renderer = make_study_renderer(device, scene, ls_flags.options());
+      const PolicyStudy study = run_policy_study(*renderer, scene_spec, spec, starts, ts, settings, log_line, policy_repeats);
+      write_policy_study(out_dir, study);
+      std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\nwrote %s/{policy.md, policy.csv, policy.json}\n", scene_spec.c_str(),
+                  settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
+                  study.markdown().c_str(), out_dir.c_str());
     } else if (*paper_cmd) {
       PaperOptions options;
       options.scenes = scene_list(scenes);

@@ -26,14 +26,18 @@ Reference render_reference(StudyRenderer& renderer, const ImageSettings& setting
 
 Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageSettings& settings,
                  const Reference& reference) {
+  return measure(renderer, settings.options(schedule), reference);
+}
+
+Measured measure(StudyRenderer& renderer, const RenderOptions& options, const Reference& reference) {
   Measured m;
-  m.schedule = schedule.name();
-  m.result = renderer.render(settings.options(schedule));
+  m.schedule = options.schedule.name();
+  m.result = renderer.render(options);
   m.rmse = rmse(reference.result.total, m.result.total, reference.scale);
   for (size_t k = 0; k < m.result.bounce_images.size(); ++k)
     m.contribution_rmse.push_back(rmse(reference.result.bounce_images[k], m.result.bounce_images[k], reference.scale));
   m.mrays_per_s = m.result.indirect_mrays_per_s();
-  m.bytes = schedule_bytes(renderer, schedule, settings.bounces);
+  for (const StructureSpec& spec : render_structures(options)) m.bytes += renderer.structure(spec).bytes_total();
   return m;
 }
 

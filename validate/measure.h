@@ -39,6 +39,8 @@ struct Measured {
 Reference render_reference(StudyRenderer& renderer, const ImageSettings& settings);
 Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageSettings& settings,
                  const Reference& reference);
+// The same for any render options (a throughput switch, say); bytes: every structure the render uses.
+Measured measure(StudyRenderer& renderer, const RenderOptions& options, const Reference& reference);
 
 // What every study's JSON opens with: the scene, the device, the image settings and the reference.
 nlohmann::json study_json(const std::string& scene, const std::string& device, const ImageSettings& settings,

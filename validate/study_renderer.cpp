@@ -16,7 +16,7 @@ const Accel& CpuStudyRenderer::structure(const StructureSpec& spec) {
 }
 
 RenderResult CpuStudyRenderer::render(const RenderOptions& options) {
-  for (int k = 0; k <= options.bounces; ++k) structure(options.schedule.at(k));
+  for (const StructureSpec& spec : render_structures(options)) structure(spec);  // the switch's too
   return ls::render(scene_, built_, options);
 }
 

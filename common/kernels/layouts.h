@@ -182,7 +182,8 @@ struct ShadeParams {
 };
 
 // One path of the wavefront (one pixel): the segment to trace, the shadow ray of the current bounce
-// and what it carries, the throughput and the density of the direction that made `ray` (MIS).
+// and what it carries, the throughput and the density of the direction that made `ray` (MIS), and
+// whether this bounce's rays are traced with the throughput switch's structure (throughput_switch.h).
 struct PathState {
   Ray ray;
   Ray shadow_ray;
@@ -191,7 +192,7 @@ struct PathState {
   vec3 shadow_contribution;
   uint alive;
   uint has_shadow;
-  uint pad0;
+  uint switched;
   uint pad1;
   uint pad2;
 };

@@ -87,7 +87,7 @@ LS_FN void start_path(uint p, uint sample_index, IN(CameraFrame) cam, OUT(PathSt
   path.shadow_contribution = vec3(0.0f, 0.0f, 0.0f);
   path.alive = 1u;
   path.has_shadow = 0u;
-  path.pad0 = 0u;
+  path.switched = 0u;
   path.pad1 = 0u;
   path.pad2 = 0u;
 }

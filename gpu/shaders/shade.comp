@@ -1,10 +1,15 @@
 #version 450
 // The path tracer's wavefront steps on the GPU, one invocation per path (common/kernels/shade_path.h,
 // the kernel the CPU renderer calls):
-//   mode 0: start every pixel's path at the camera and list its ray for bounce 0;
+//   mode 0: start the path of every listed pixel (batch_pixels: all, or a shard's tiles) at the camera
+//           and list its ray for bounce 0;
 //   mode 1: shade the hits of the listed paths, add what they found to the bounce image, and append
 //           their shadow rays and next segments (atomically; the order of a batch changes no image);
-//   mode 2: add the light of the shadow rays that reached their light.
+//   mode 2: add the light of the shadow rays that reached their light;
+//   mode 3: with the throughput switch on, split a list of this bounce's rays: the paths that follow
+//           the schedule to the first output list (next_*), the switched ones to the second (shadow_*).
+//           For extension rays (list_kind 0) it decides first (kernels/throughput_switch.h) and keeps
+//           the decision in the path for its shadow ray (list_kind 1).
 // The host (gpu/gpu_renderer.cpp) traces the lists with trace.comp between these steps.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 64) in;
@@ -32,27 +37,42 @@ layout(push_constant) uniform ShadePush {
   uint mode;
   uint sample_index;
   uint bounce;
-  uint count;         // paths (mode 0) or batch entries (modes 1, 2)
+  uint count;         // batch entries: pixels to start (mode 0), hits to shade (modes 1, 2)
   uint image_offset;  // first float of this bounce's image
+  uint list_kind;     // mode 3: 0 extension rays, 1 shadow rays
+  float switch_threshold;
   uint pad0;
-  uint pad1;
-  uint pad2;
 } pc;
 
 #include "kernels/shade_path.h"
+#include "kernels/throughput_switch.h"
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.count) return;
+  uint p = batch_pixels[i];
   if (pc.mode == 0u) {
     PathState path;
-    start_path(i, pc.sample_index, cam, path);
-    paths[i] = path;
+    start_path(p, pc.sample_index, cam, path);
+    paths[p] = path;
     next_rays[i] = path.ray;
-    next_pixels[i] = i;
+    next_pixels[i] = p;
     return;
   }
-  uint p = batch_pixels[i];
+  if (pc.mode == 3u) {
+    if (pc.list_kind == 0u) paths[p].switched = throughput_switched(paths[p].throughput, pc.switch_threshold);
+    Ray ray = pc.list_kind == 0u ? paths[p].ray : paths[p].shadow_ray;
+    if (paths[p].switched != 0u) {
+      uint j = atomicAdd(shadow_count, 1u);
+      shadow_rays[j] = ray;
+      shadow_pixels[j] = p;
+    } else {
+      uint j = atomicAdd(next_count, 1u);
+      next_rays[j] = ray;
+      next_pixels[j] = p;
+    }
+    return;
+  }
   uint base = pc.image_offset + 3u * p;
   vec3 pixel = vec3(images[base], images[base + 1u], images[base + 2u]);
   uint d = dropped[p];

@@ -13,6 +13,7 @@ layout(local_size_x = 64) in;
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
 #include "kernels/camera.h"
+#include "kernels/throughput_switch.h"
 layout(std430, binding = 0) readonly buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = 1) readonly buffer Tris { Triangle tris[]; };
 layout(std430, binding = 2) readonly buffer TriIds { uint tri_ids[]; };
