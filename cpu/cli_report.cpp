@@ -35,6 +35,7 @@ nlohmann::json ls_plan_json(const LsPlan& p) {
           {"plan", figures(p.plan)},
           {"uniform", figures(p.uniform)},
           {"pilot_rays", p.pilot_rays},
+          {"pilot_shadow_rays", p.pilot_shadow_rays},
           {"evaluations", p.evaluations},
           {"shafts_searched", p.shafts_searched},
           {"seconds", p.seconds},
@@ -42,9 +43,10 @@ nlohmann::json ls_plan_json(const LsPlan& p) {
 }
 
 void print_ls_plan(const LsPlan& p) {
-  std::printf("ls_plan        budget %.2f MB: %.2f MB (fixed %.2f MB); %zu pilot rays, %zu evaluations, %zu shafts searched, %.2f s\n",
-              double(p.budget) / 1e6, double(p.predicted_bytes) / 1e6, double(p.fixed_bytes) / 1e6, p.pilot_rays, p.evaluations,
-              p.shafts_searched, p.seconds);
+  std::printf("ls_plan        budget %.2f MB: %.2f MB (fixed %.2f MB); %zu + %zu shadow pilot rays, %zu evaluations, %zu shafts "
+              "searched, %.2f s\n",
+              double(p.budget) / 1e6, double(p.predicted_bytes) / 1e6, double(p.fixed_bytes) / 1e6, p.pilot_rays,
+              p.pilot_shadow_rays, p.evaluations, p.shafts_searched, p.seconds);
   std::printf("  on the pilot  plan: error %.5f, saved work %.1f per ray, %.2f MB", p.plan.error, p.plan.saved_work,
               double(p.plan.bytes_ls) / 1e6);
   if (!p.reference.empty())

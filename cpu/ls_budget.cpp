@@ -3,13 +3,19 @@
 #include "accel.h"
 #include "interrupt.h"
 #include "kernels/ray_box.h"
+#include "kernels/offset_ray.h"
+#include "kernels/rng.h"
+#include "kernels/sampling.h"
+#include "path_tracer.h"
 #include "ray_generators.h"
+#include "surface.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -30,12 +36,12 @@ struct Traced {
   double work = 0.0;
 };
 
-// Closest hits by the reference traversal (the one that counts its work), on all threads.
-Traced trace_counted(const Accel& accel, const std::vector<lsk::Ray>& rays) {
+// Hits by the reference traversal (the one that counts its work), on all threads.
+Traced trace_counted(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit) {
   Traced out;
   out.hits.resize(rays.size());
   TraceWorkTotals w;
-  trace_rays(accel, rays.data(), out.hits.data(), rays.size(), false, nullptr, Traversal::Reference, &w);
+  trace_rays(accel, rays.data(), out.hits.data(), rays.size(), any_hit, nullptr, Traversal::Reference, &w);
   out.work = double(w.box_tests) + kTriangleWeight * double(w.triangle_tests) + kLookupWeight * double(w.lookups);
   return out;
 }
@@ -156,10 +162,71 @@ std::vector<size_t> knapsack(const std::vector<std::vector<PlanOption>>& options
   return choice;
 }
 
+// One kind of pilot ray (closest hit or any hit) with its exact answers and work.
+struct PilotSet {
+  std::vector<lsk::Ray> rays;
+  bool any_hit = false;
+  Traced exact;
+};
+
+// What a structure does on `subset` of a pilot set: wrong answers (pilot_answer_wrong) and work.
+struct Outcome {
+  size_t wrong = 0;
+  double work = 0.0;
+};
+
+std::vector<lsk::Ray> gather(const PilotSet& set, const std::vector<uint32_t>& subset) {
+  std::vector<lsk::Ray> rays(subset.size());
+  for (size_t i = 0; i < subset.size(); ++i) rays[i] = set.rays[subset[i]];
+  return rays;
+}
+
+Outcome run_on(const Accel& accel, const PilotSet& set, const std::vector<uint32_t>& subset, double tolerance) {
+  const std::vector<lsk::Ray> rays = gather(set, subset);
+  const Traced got = trace_counted(accel, rays, set.any_hit);
+  Outcome o;
+  o.work = got.work;
+  for (size_t i = 0; i < rays.size(); ++i)
+    o.wrong += pilot_answer_wrong(rays[i], got.hits[i], set.exact.hits[subset[i]], set.any_hit, tolerance);
+  return o;
+}
+
 }  // namespace
 
-std::vector<lsk::Ray> ls_budget_pilot_rays(const Scene& scene, const Accel& exact, size_t count) {
-  return generate_rays(scene, exact, RayKind::Diffuse, std::max<size_t>(1, count), kPilotSeed);
+LsPilot ls_budget_pilot(const Scene& scene, const Accel& exact, size_t count) {
+  LsPilot pilot;
+  pilot.rays = generate_rays(scene, exact, RayKind::Diffuse, std::max<size_t>(1, count), kPilotSeed);
+  // Shadow rays as the path tracer casts them: from each exact hit, offset, to a point on a light
+  // picked by power, both ends offset; none where the light lies behind the surface.
+  const SurfaceLookup surfaces(scene);
+  const LightSet lights(scene, surfaces);
+  if (lights.lights.empty()) return pilot;
+  for (uint32_t i = 0; i < pilot.rays.size(); ++i) {
+    const lsk::Hit h = trace_ray(exact.context(), exact, pilot.rays[i], false);
+    if (h.triangle == lsk::LS_INVALID) continue;
+    const SurfacePoint sp = surfaces.at(h, pilot.rays[i].dir);
+    const float pick = lsk::random01(kPilotSeed, i, 0, 1, 0);
+    const size_t l = std::min(size_t(std::upper_bound(lights.cdf.begin(), lights.cdf.end(), pick) - lights.cdf.begin()),
+                              lights.lights.size() - 1);
+    const lsk::ShadeLight& light = lights.lights[l];
+    const glm::vec3 q = lsk::sample_triangle(light.a, light.b, light.c, lsk::random01(kPilotSeed, i, 0, 1, 1),
+                                             lsk::random01(kPilotSeed, i, 0, 1, 2));
+    const glm::vec3 origin = lsk::offset_ray_origin(sp.position, sp.geometric_normal, surfaces.scene_scale());
+    const glm::vec3 nl = glm::dot(light.normal, origin - q) < 0.0f ? -light.normal : light.normal;
+    const glm::vec3 target = lsk::offset_ray_origin(q, nl, surfaces.scene_scale());
+    lsk::Ray r;
+    r.origin = origin;
+    r.tmin = 0.0f;
+    r.dir = target - origin;
+    r.tmax = 1.0f;
+    if (glm::dot(sp.geometric_normal, r.dir) > 0.0f) pilot.shadow_rays.push_back(r);
+  }
+  return pilot;
+}
+
+bool pilot_answer_wrong(const lsk::Ray& ray, const lsk::Hit& got, const lsk::Hit& exact, bool any_hit, double tolerance) {
+  if (any_hit) return (got.triangle != lsk::LS_INVALID) != (exact.triangle != lsk::LS_INVALID);
+  return pilot_answer_moved(ray, got, exact, tolerance);
 }
 
 double pilot_tolerance(const Scene& scene) { return kMoveTolerance * double(glm::length(world_bounds(scene).extent())); }
@@ -258,15 +325,21 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
   const size_t meshes = scene.meshes.size();
   const BvhSubtrees subtrees = bvh_subtrees(accel);
 
-  // The pilot: diffuse rays, their exact hits and the exact traversal's work (no Line Space yet).
-  const std::vector<lsk::Ray> rays = ls_budget_pilot_rays(scene, accel, options.budget_rays);
-  const Traced exact = trace_counted(accel, rays);
-  plan.pilot_rays = rays.size();
-  const double per_ray = 1.0 / double(rays.size());
+  // The pilot: diffuse and shadow rays, their exact answers and the exact traversal's work (no Line
+  // Space yet).
+  LsPilot pilot = ls_budget_pilot(scene, accel, options.budget_rays);
+  std::array<PilotSet, 2> sets;
+  sets[0].rays = std::move(pilot.rays);
+  sets[1].rays = std::move(pilot.shadow_rays);
+  sets[1].any_hit = true;
+  for (PilotSet& set : sets) set.exact = trace_counted(accel, set.rays, set.any_hit);
+  plan.pilot_rays = sets[0].rays.size();
+  plan.pilot_shadow_rays = sets[1].rays.size();
+  const double per_ray = 1.0 / double(plan.pilot_rays + plan.pilot_shadow_rays);
   const double tolerance = pilot_tolerance(scene);
 
-  // Per object: the pilot rays whose exact segment crosses one of its instance boxes (the only rays
-  // its Line Space can change), and the pilot rays that hit it.
+  // Per object: the pilot rays whose exact segment (any-hit: the whole segment) crosses one of its
+  // instance boxes (the only rays its Line Space can change), and the diffuse pilot rays that hit it.
   std::vector<std::vector<Bounds>> boxes(meshes);
   std::vector<size_t> instances(meshes, 0), hits(meshes, 0);
   for (const Instance& inst : scene.instances) {
@@ -276,25 +349,30 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
     const glm::vec3 slack = 1e-5f * (b.extent() + glm::abs(b.lo) + glm::abs(b.hi));  // the transform's rounding
     boxes[inst.mesh].push_back(Bounds{b.lo - slack, b.hi + slack});
   }
-  for (const lsk::Hit& h : exact.hits)
+  for (const lsk::Hit& h : sets[0].exact.hits)
     if (h.triangle != lsk::LS_INVALID) ++hits[scene.instances[h.instance].mesh];
-  std::vector<std::vector<uint32_t>> crossing(rays.size());
-  tbb::parallel_for(size_t(0), rays.size(), [&](size_t i) {
-    const lsk::Ray& r = rays[i];
-    const glm::vec3 inv = lsk::safe_reciprocal(r.dir);
-    const float t_end = exact.hits[i].triangle != lsk::LS_INVALID ? exact.hits[i].t : r.tmax;
-    for (uint32_t m = 0; m < meshes; ++m)
-      for (const Bounds& b : boxes[m]) {
-        float t_near;
-        if (lsk::ray_box(r.origin, inv, r.tmin, t_end, b.lo, b.hi, t_near)) {
-          crossing[i].push_back(m);
-          break;
+  std::array<std::vector<std::vector<uint32_t>>, 2> relevant;  // [set][mesh]: ray indices
+  for (size_t k = 0; k < sets.size(); ++k) {
+    const PilotSet& set = sets[k];
+    std::vector<std::vector<uint32_t>> crossing(set.rays.size());
+    tbb::parallel_for(size_t(0), set.rays.size(), [&](size_t i) {
+      const lsk::Ray& r = set.rays[i];
+      const glm::vec3 inv = lsk::safe_reciprocal(r.dir);
+      const bool closest = !set.any_hit && set.exact.hits[i].triangle != lsk::LS_INVALID;
+      const float t_end = closest ? set.exact.hits[i].t : r.tmax;
+      for (uint32_t m = 0; m < meshes; ++m)
+        for (const Bounds& b : boxes[m]) {
+          float t_near;
+          if (lsk::ray_box(r.origin, inv, r.tmin, t_end, b.lo, b.hi, t_near)) {
+            crossing[i].push_back(m);
+            break;
+          }
         }
-      }
-  });
-  std::vector<std::vector<uint32_t>> relevant(meshes);
-  for (uint32_t i = 0; i < rays.size(); ++i)
-    for (uint32_t m : crossing[i]) relevant[m].push_back(i);
+    });
+    relevant[k].resize(meshes);
+    for (uint32_t i = 0; i < set.rays.size(); ++i)
+      for (uint32_t m : crossing[i]) relevant[k][m].push_back(i);
+  }
 
   // The vertex normals of every object, once for all evaluations.
   LsOptions scratch = options;
@@ -311,8 +389,9 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
   for (uint32_t m = 0; m < meshes; ++m) {
     const uint32_t root = accel.object_roots[m];
     if (root == lsk::LS_INVALID) continue;
-    std::vector<lsk::Ray> batch(relevant[m].size());
-    for (size_t i = 0; i < batch.size(); ++i) batch[i] = rays[relevant[m][i]];
+    const bool reached = !relevant[0][m].empty() || !relevant[1][m].empty();
+    std::vector<lsk::Ray> batch = gather(sets[0], relevant[0][m]), shadow_batch = gather(sets[1], relevant[1][m]);
+    batch.insert(batch.end(), shadow_batch.begin(), shadow_batch.end());  // every ray that can look it up
     double exact_work = -1.0;
     for (size_t e = 0; e < menu.size(); ++e) {
       const ObjectLs c = menu[e];
@@ -322,10 +401,10 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
       menu_bytes[m][e] = bytes;
       if (bytes > room) continue;
       PlanOption opt{c, bytes, 0.0, 0.0};
-      if (!batch.empty()) {
+      if (reached) {
         if (exact_work < 0.0) {
           accel.node_ls.clear();
-          exact_work = trace_counted(accel, batch).work;
+          exact_work = run_on(accel, sets[0], relevant[0][m], tolerance).work + run_on(accel, sets[1], relevant[1][m], tolerance).work;
         }
         LsOptions single = scratch;
         single.objects.assign(meshes, ObjectLs{});
@@ -334,11 +413,9 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
         std::vector<int> depth_of_mesh(meshes, -1);
         depth_of_mesh[m] = c.depth;
         plan.shafts_searched += search_shafts_of(accel, batch, subtrees, depth_of_mesh, options);
-        const Traced got = trace_counted(accel, batch);
-        size_t wrong = 0;
-        for (size_t i = 0; i < batch.size(); ++i) wrong += pilot_answer_moved(batch[i], got.hits[i], exact.hits[relevant[m][i]], tolerance);
-        opt.error = double(wrong) * per_ray;
-        opt.saved = (exact_work - got.work) * per_ray;
+        const Outcome a = run_on(accel, sets[0], relevant[0][m], tolerance), b = run_on(accel, sets[1], relevant[1][m], tolerance);
+        opt.error = double(a.wrong + b.wrong) * per_ray;
+        opt.saved = (exact_work - a.work - b.work) * per_ray;
         ++plan.evaluations;
       }
       // No ray moved and under a hundredth of a box test saved per ray: nothing measurable to buy
@@ -389,14 +466,14 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
     row.triangles = scene.meshes[m].triangles.size();
     row.instances = instances[m];
     row.hits = hits[m];
-    row.relevant = relevant[m].size();
+    row.relevant = relevant[0][m].size() + relevant[1][m].size();
     const PlanOption& o = options_of[m][choice[m]];
     row.chosen = o.ls;
     row.bytes = o.bytes;
     row.error = o.error;
     row.saved_work = o.saved;
     if (ref < menu.size() && menu_bytes[m][ref] > 0) row.reference = menu[ref];
-    row.reason = o.ls.n > 0 ? "chosen" : !placeable[m] ? "too small" : relevant[m].empty() ? "not reached" : "no gain";
+    row.reason = o.ls.n > 0 ? "chosen" : !placeable[m] ? "too small" : row.relevant == 0 ? "not reached" : "no gain";
     plan.predicted_bytes += row.bytes;
     plan.rows.push_back(row);
   }
@@ -412,12 +489,16 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
     std::vector<int> depth_of_mesh(meshes, -1);
     for (size_t m = 0; m < meshes; ++m)
       if (objects[m].n > 0) depth_of_mesh[m] = objects[m].depth;
-    plan.shafts_searched += search_shafts_of(accel, rays, subtrees, depth_of_mesh, options);
-    const Traced got = trace_counted(accel, rays);
-    size_t wrong = 0;
-    for (size_t i = 0; i < rays.size(); ++i) wrong += pilot_answer_moved(rays[i], got.hits[i], exact.hits[i], tolerance);
-    f.error = double(wrong) * per_ray;
-    f.saved_work = (exact.work - got.work) * per_ray;
+    std::vector<lsk::Ray> all_rays = sets[0].rays;
+    all_rays.insert(all_rays.end(), sets[1].rays.begin(), sets[1].rays.end());
+    plan.shafts_searched += search_shafts_of(accel, all_rays, subtrees, depth_of_mesh, options);
+    for (const PilotSet& set : sets) {
+      std::vector<uint32_t> every(set.rays.size());
+      for (uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+      const Outcome o = run_on(accel, set, every, tolerance);
+      f.error += double(o.wrong) * per_ray;
+      f.saved_work += (set.exact.work - o.work) * per_ray;
+    }
     return f;
   };
   plan.plan = joint(plan.objects(meshes));

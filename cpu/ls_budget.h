@@ -1,13 +1,14 @@
 // 2l-ls:auto: which objects of a two-level structure get a Line Space, and with which integration
 // depth D and subdivision N, within a memory budget (--ls-budget MB).
 //
-// Measured, not modelled.  A pilot of diffuse rays (the rays a Line Space serves: bounces >= 1) is
-// traced exactly, then for every object and every (D, N) of the menu with a Line Space on that object
-// alone.  Only the shafts those rays can look up are searched (a lookup's shaft depends on the ray's
+// Measured, not modelled.  A pilot of diffuse rays (the rays a Line Space serves: bounces >= 1) and
+// of shadow rays from their hits to the lights (as the path tracer casts them) is traced exactly,
+// then for every object and every (D, N) of the menu with a Line Space on that object alone.  Only the shafts those rays can look up are searched (a lookup's shaft depends on the ray's
 // line and the LS box alone), so one evaluation costs a few thousand searches whatever N and D.  Per
 // object and option this gives:
 //   error  the pilot rays whose answer moved (another instance, hit and miss swapped, or a hit point
-//          more than 1e-3 of the scene's diagonal away), over all pilot rays;
+//          more than 1e-3 of the scene's diagonal away; for shadow rays: occluded or not changed),
+//          over all pilot rays;
 //   work   box tests + 2.3 x triangle tests + 5.7 x Line Space lookups of those rays (the weights
 //          are the reference traversal's instruction costs, measured: README "2l-ls:auto"); the
 //          option's saved work is the exact traversal's minus its own.
@@ -66,7 +67,8 @@ struct LsPlan {
   bool reference_chosen = false;  // the optimiser did not beat the reference: the plan is the reference
   double lambda = 0.0;         // the work constraint's multiplier
   PilotFigures plan, uniform;  // joint pilot evaluations of the plan and of the reference
-  size_t pilot_rays = 0;
+  size_t pilot_rays = 0;         // diffuse (closest hit)
+  size_t pilot_shadow_rays = 0;  // to the lights (any hit)
   size_t evaluations = 0;      // (object, D, N) options evaluated
   size_t shafts_searched = 0;
   double seconds = 0.0;
@@ -78,10 +80,18 @@ struct LsPlan {
 // The menu of (D, N) an object can get.
 std::vector<ObjectLs> ls_budget_menu();
 
-// The pilot's pieces, for tests and studies that check the plan against full builds.
-std::vector<lsk::Ray> ls_budget_pilot_rays(const Scene& scene, const Accel& exact, size_t count);
+// The pilot's pieces, for tests and studies that check the plan against full builds: `count` diffuse
+// rays (closest hit) and a shadow ray (any hit) from each one's exact hit to a light, as the path
+// tracer casts them (none in a scene without emissive triangles).
+struct LsPilot {
+  std::vector<lsk::Ray> rays, shadow_rays;
+};
+LsPilot ls_budget_pilot(const Scene& scene, const Accel& exact, size_t count);
 double pilot_tolerance(const Scene& scene);  // 1e-3 of the scene's diagonal
+// Closest hit: another instance, hit and miss swapped, or the hit point moved more than tolerance.
 bool pilot_answer_moved(const lsk::Ray& ray, const lsk::Hit& got, const lsk::Hit& exact, double tolerance);
+// Any hit: occluded or not changed; closest hit: pilot_answer_moved.
+bool pilot_answer_wrong(const lsk::Ray& ray, const lsk::Hit& got, const lsk::Hit& exact, bool any_hit, double tolerance);
 
 // The optimiser on its own.  options[o][0] is object o's "none" (0 bytes, no error, no saved work);
 // reference[o] indexes the reference's option per object (empty: no reference, every object none).

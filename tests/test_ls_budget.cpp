@@ -151,17 +151,23 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
   const Accel planned = build_accel(scene, parse_structure("2l-ls:auto"), options);
   const LsPlan& plan = *planned.ls_plan;
   REQUIRE(!plan.reference.empty());
-  const std::vector<lsk::Ray> rays = ls_budget_pilot_rays(scene, exact, options.ls.budget_rays);
-  REQUIRE(rays.size() == plan.pilot_rays);
-  const std::vector<lsk::Hit> truth = trace_all(exact, rays);
+  const LsPilot pilot = ls_budget_pilot(scene, exact, options.ls.budget_rays);
+  REQUIRE(pilot.rays.size() == plan.pilot_rays);
+  REQUIRE(pilot.shadow_rays.size() == plan.pilot_shadow_rays);
+  REQUIRE(plan.pilot_shadow_rays > 0);  // the generated scene has a light quad
   const double tolerance = pilot_tolerance(scene);
   auto wrong_rays = [&](const Accel& a) {
-    const std::vector<lsk::Hit> got = trace_all(a, rays);
     long wrong = 0;
-    for (size_t i = 0; i < rays.size(); ++i) wrong += pilot_answer_moved(rays[i], got[i], truth[i], tolerance);
+    for (bool any_hit : {false, true}) {
+      const std::vector<lsk::Ray>& rays = any_hit ? pilot.shadow_rays : pilot.rays;
+      std::vector<lsk::Hit> truth(rays.size()), got(rays.size());
+      trace_rays(exact, rays.data(), truth.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
+      trace_rays(a, rays.data(), got.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
+      for (size_t i = 0; i < rays.size(); ++i) wrong += pilot_answer_wrong(rays[i], got[i], truth[i], any_hit, tolerance);
+    }
     return wrong;
   };
-  const double n = double(rays.size());
+  const double n = double(pilot.rays.size() + pilot.shadow_rays.size());
   CHECK(wrong_rays(planned) == std::lround(plan.plan.error * n));
   const Accel uniform = build_accel(scene, parse_structure(plan.reference));
   CHECK(wrong_rays(uniform) == std::lround(plan.uniform.error * n));
