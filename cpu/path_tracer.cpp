@@ -3,9 +3,8 @@
 #include "interrupt.h"
 #include "kernels/sampling.h"
 #include "kernels/scaled_geometry.h"
+#include "parallel.h"
 #include "surface.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -146,7 +145,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
     const uint32_t sample = uint32_t(s);
-    tbb::parallel_for(uint32_t(0), pixels, [&](uint32_t p) { shading.start_path(p, sample, cam, paths[p]); });
+    ls::parallel_for(uint32_t(0), pixels, [&](uint32_t p) { shading.start_path(p, sample, cam, paths[p]); });
 
     for (int k = 0; k <= bounces; ++k) {
       throw_if_interrupted();
@@ -175,7 +174,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       if (active.empty()) break;
 
       // Shade: emission found, a light sample for next-event estimation, the next direction.
-      tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
+      ls::parallel_for(size_t(0), active.size(), [&](size_t i) {
         const uint32_t p = active[i];
         shading.shade_path(p, sample, bounce, batch_hits[i], paths[p], image[p], dropped[p]);
       });
@@ -183,7 +182,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       // Trace this bounce's shadow rays (any hit) and add the light they let through.
       stats.shadow_rays += trace_selected([&](uint32_t p) { return paths[p].has_shadow != 0; },
                                           [&](uint32_t p) { return paths[p].shadow_ray; }, true);
-      tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
+      ls::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
         const uint32_t p = active[i];
         shading.add_shadow_light(paths[p], image[p], dropped[p]);
