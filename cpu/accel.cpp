@@ -3,9 +3,9 @@
 #include "ls_budget.h"
 #include "memory_budget.h"
 #include "top_level_update.h"
+#include "parallel.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <chrono>
@@ -45,10 +45,10 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
   const size_t total = first.back();
   std::vector<lsk::Triangle> world(total);
   std::vector<Bounds> boxes(total);
-  tbb::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
+  ls::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
     const Instance& inst = scene.instances[i];
     const Mesh& mesh = scene.meshes[inst.mesh];
-    tbb::parallel_for(size_t(0), mesh.triangles.size(), [&](size_t t) {
+    ls::parallel_for(size_t(0), mesh.triangles.size(), [&](size_t t) {
       const glm::uvec3 idx = mesh.triangles[t];
       const glm::vec3 a = transform_point(inst.object_to_world, mesh.positions[idx.x]);
       const glm::vec3 b = transform_point(inst.object_to_world, mesh.positions[idx.y]);
@@ -63,7 +63,7 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
   accel.tris.resize(total);
   accel.tri_ids.resize(total);
   accel.tri_instances.resize(total);
-  tbb::parallel_for(size_t(0), total, [&](size_t k) {
+  ls::parallel_for(size_t(0), total, [&](size_t k) {
     const size_t src = bvh.order[k];
     const size_t inst = size_t(std::upper_bound(first.begin(), first.end(), src) - first.begin()) - 1;
     accel.tris[k] = world[src];
@@ -79,7 +79,7 @@ void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& 
 
   // One BVH per unique mesh, in object space, built in parallel.
   std::vector<BvhBuildResult> object_bvh(scene.meshes.size());
-  tbb::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
+  ls::parallel_for(size_t(0), scene.meshes.size(), [&](size_t m) {
     const Mesh& mesh = scene.meshes[m];
     if (!used[m] || mesh.triangles.empty()) return;
     std::vector<Bounds> boxes(mesh.triangles.size());
@@ -216,7 +216,7 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
   // Per-thread counters, summed once at the end: no lock on the hot path.
   tbb::enumerable_thread_specific<lsk::LsCounters> per_thread(lsk::LsCounters{});
   tbb::enumerable_thread_specific<TraceWorkTotals> per_thread_work;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
+  ls::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
     lsk::TraceContext local = context;
     if (fast)
       fast->trace(local, rays + r.begin(), hits + r.begin(), r.size(), any_hit);

@@ -1,10 +1,7 @@
 #include "bvh_builder.h"
 
 #include "interrupt.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_invoke.h>
-#include <tbb/parallel_reduce.h>
+#include "parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -79,8 +76,8 @@ class Builder {
       return info;
     };
     if (end - begin <= kParallelRange) return body(tbb::blocked_range<uint32_t>(begin, end), RangeInfo{});
-    return tbb::parallel_reduce(tbb::blocked_range<uint32_t>(begin, end, 1024), RangeInfo{}, body,
-                                [](RangeInfo a, const RangeInfo& b) { a.merge(b); return a; });
+    return ls::parallel_reduce(tbb::blocked_range<uint32_t>(begin, end, 1024), RangeInfo{}, body,
+                               [](RangeInfo a, const RangeInfo& b) { a.merge(b); return a; });
   }
 
   // The bin of a centroid along an axis; the same formula bins and partitions.
@@ -101,8 +98,8 @@ class Builder {
       return set;
     };
     if (end - begin <= kParallelRange) return body(tbb::blocked_range<uint32_t>(begin, end), BinSet{});
-    return tbb::parallel_reduce(tbb::blocked_range<uint32_t>(begin, end, 4096), BinSet{}, body,
-                                [this](BinSet a, const BinSet& b) { a.merge(b, bins_); return a; });
+    return ls::parallel_reduce(tbb::blocked_range<uint32_t>(begin, end, 4096), BinSet{}, body,
+                               [this](BinSet a, const BinSet& b) { a.merge(b, bins_); return a; });
   }
 
   // Splits at the object median along the widest centroid axis (ties by index: deterministic).
@@ -186,8 +183,8 @@ class Builder {
     }
     if (n > kParallelRange) {
       throw_if_interrupted();  // large subtrees only: the check costs nothing beside their work
-      tbb::parallel_invoke([&] { node->left = build(begin, mid, depth + 1); },
-                           [&] { node->right = build(mid, end, depth + 1); });
+      ls::parallel_invoke([&] { node->left = build(begin, mid, depth + 1); },
+                          [&] { node->right = build(mid, end, depth + 1); });
     } else {
       node->left = build(begin, mid, depth + 1);
       node->right = build(mid, end, depth + 1);

@@ -10,9 +10,9 @@
 // callback only records the message: throwing through Embree's C frames would be undefined.
 #include "embree_tracer.h"
 
+#include "parallel.h"
+
 #include <embree3/rtcore.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <chrono>
@@ -100,7 +100,7 @@ EmbreeTracer::EmbreeTracer(const Scene& scene) : impl_(std::make_unique<Impl>())
       throw InputError("Embree: cannot allocate geometry buffers");
     }
     const glm::mat4 m = inst.object_to_world;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.positions.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    ls::parallel_for(tbb::blocked_range<size_t>(0, mesh.positions.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i != r.end(); ++i) {
         const glm::vec3 p = transform_point(m, mesh.positions[i]);
         vertices[3 * i + 0] = p.x;
@@ -142,7 +142,7 @@ size_t EmbreeTracer::bytes() const {
 void EmbreeTracer::trace(const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit) const {
   const RTCScene scene = impl_->scene;
   constexpr float inf = std::numeric_limits<float>::infinity();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& range) {
+  ls::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& range) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     for (size_t i = range.begin(); i != range.end(); ++i) {

@@ -1,13 +1,12 @@
 #include "fast_tracer.h"
 
 #include "accel.h"
+#include "parallel.h"
 #include "wide_bvh.h"
 
-#include <tbb/parallel_for.h>
 #include <xsimd/xsimd.hpp>
 
 #include <bit>
-
 
 namespace ls {
 
@@ -310,7 +309,7 @@ class WideTracer final : public FastTracer {
           total += (node.count[lane] + 3u) / 4u;
         }
     part->blocks.assign(total, TriBlock{});
-    tbb::parallel_for(size_t(0), part->tree.nodes.size(), [&](size_t n) {
+    ls::parallel_for(size_t(0), part->tree.nodes.size(), [&](size_t n) {
       const WideNode<K>& node = part->tree.nodes[n];
       for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
         for (uint32_t k = 0; k < node.count[lane]; ++k) {

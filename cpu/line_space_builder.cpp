@@ -2,9 +2,9 @@
 
 #include "accel.h"
 #include "interrupt.h"
+#include "parallel.h"
 
 #include <glm/gtc/packing.hpp>
-#include <tbb/parallel_for.h>
 
 #include <unistd.h>
 
@@ -68,7 +68,7 @@ void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees,
       if (accel.object_roots[m] == lsk::LS_INVALID || object_line_space(accel, options, m).n <= 0) continue;
       const Mesh& mesh = scene.meshes[m];
       const uint32_t root = accel.object_roots[m];
-      tbb::parallel_for(subtrees.first[root], subtrees.first[root] + subtrees.count[root], [&](uint32_t k) {
+      ls::parallel_for(subtrees.first[root], subtrees.first[root] + subtrees.count[root], [&](uint32_t k) {
         const glm::uvec3 idx = mesh.triangles[accel.tri_ids[k]];
         accel.tri_normals[k] = encode_normals(mesh.normals[idx.x], mesh.normals[idx.y], mesh.normals[idx.z]);
       });
@@ -78,7 +78,7 @@ void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees,
   std::vector<glm::mat3> normal_matrix;
   for (const Instance& inst : scene.instances)
     normal_matrix.push_back(glm::transpose(glm::inverse(glm::mat3(inst.object_to_world))));
-  tbb::parallel_for(size_t(0), accel.tris.size(), [&](size_t k) {
+  ls::parallel_for(size_t(0), accel.tris.size(), [&](size_t k) {
     const uint32_t inst = accel.tri_instances[k];
     const Mesh& mesh = scene.meshes[scene.instances[inst].mesh];
     const glm::uvec3 idx = mesh.triangles[accel.tri_ids[k]];
@@ -283,15 +283,15 @@ void search_line_space(const LsOptions& options, Accel& accel) {
   const uint32_t instance = ls_search_instance(accel);
   std::atomic<size_t> empty{0}, nodes_done{0};
   std::mutex progress_mutex;
-  tbb::parallel_for(size_t(0), accel.ls_nodes.size(), [&](size_t li) {
-    const lsk::LsNode ls = accel.ls_nodes[li];
-    const uint32_t shafts = lsk::ls_shaft_count(ls.n);
+  ls::parallel_for(size_t(0), accel.ls_nodes.size(), [&](size_t li) {
+    const lsk::LsNode ls_node = accel.ls_nodes[li];  // (not `ls`: that would hide namespace ls)
+    const uint32_t shafts = lsk::ls_shaft_count(ls_node.n);
     std::vector<uint32_t> prims(shafts);
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
+    ls::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
       throw_if_interrupted();  // TBB cancels the other blocks and rethrows in the caller
       lsk::TraceContext c = context;
       for (uint32_t s = r.begin(); s != r.end(); ++s)
-        prims[s] = c.ls_find_candidate(ls.node, ls, s, uint32_t(options.further_rays), instance);
+        prims[s] = c.ls_find_candidate(ls_node.node, ls_node, s, uint32_t(options.further_rays), instance);
     });
     empty += pack_ls_candidates(accel, li, prims.data());  // nodes own disjoint words
     const size_t done = ++nodes_done;

@@ -2,17 +2,16 @@
 
 #include "accel.h"
 #include "interrupt.h"
-#include "kernels/ray_box.h"
 #include "kernels/offset_ray.h"
+#include "kernels/ray_box.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
+#include "parallel.h"
 #include "path_tracer.h"
 #include "ray_generators.h"
 #include "surface.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -56,7 +55,7 @@ size_t search_shafts_of(Accel& accel, const std::vector<lsk::Ray>& rays, const B
   lsk::TraceContext base = accel.context();
   base.ls_enabled = 0;
   tbb::enumerable_thread_specific<std::vector<uint64_t>> found;  // LS index << 32 | shaft
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+  ls::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
     lsk::TraceContext c = base;
     std::vector<uint64_t>& out = found.local();
     std::vector<uint32_t> stack;
@@ -93,11 +92,11 @@ size_t search_shafts_of(Accel& accel, const std::vector<lsk::Ray>& rays, const B
   });
   std::vector<uint64_t> shafts;
   for (const std::vector<uint64_t>& f : found) shafts.insert(shafts.end(), f.begin(), f.end());
-  tbb::parallel_sort(shafts.begin(), shafts.end());
+  std::sort(shafts.begin(), shafts.end());
   shafts.erase(std::unique(shafts.begin(), shafts.end()), shafts.end());
   std::vector<uint32_t> prims(shafts.size());
   const uint32_t instance = ls_search_instance(accel);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, shafts.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+  ls::parallel_for(tbb::blocked_range<size_t>(0, shafts.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
     throw_if_interrupted();
     lsk::TraceContext c = base;
     for (size_t k = r.begin(); k != r.end(); ++k) {
@@ -355,7 +354,7 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const LsOptions&
   for (size_t k = 0; k < sets.size(); ++k) {
     const PilotSet& set = sets[k];
     std::vector<std::vector<uint32_t>> crossing(set.rays.size());
-    tbb::parallel_for(size_t(0), set.rays.size(), [&](size_t i) {
+    ls::parallel_for(size_t(0), set.rays.size(), [&](size_t i) {
       const lsk::Ray& r = set.rays[i];
       const glm::vec3 inv = lsk::safe_reciprocal(r.dir);
       const bool closest = !set.any_hit && set.exact.hits[i].triangle != lsk::LS_INVALID;

@@ -4,9 +4,8 @@
 #include "kernels/sampling.h"
 #include "kernels/scaled_geometry.h"
 #include "kernels/throughput_switch.h"
+#include "parallel.h"
 #include "surface.h"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -206,7 +205,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
     const uint32_t sample = uint32_t(s);
-    tbb::parallel_for(size_t(0), order.size(), [&](size_t i) { shading.start_path(order[i], sample, cam, paths[order[i]]); });
+    ls::parallel_for(size_t(0), order.size(), [&](size_t i) { shading.start_path(order[i], sample, cam, paths[order[i]]); });
 
     for (int k = 0; k <= bounces; ++k) {
       throw_if_interrupted();
@@ -240,7 +239,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
 
       // Decide which paths switch structure at this bounce (the kernel's rule, as on the GPU).
       if (switched.accel)
-        tbb::parallel_for(size_t(0), order.size(), [&](size_t i) {
+        ls::parallel_for(size_t(0), order.size(), [&](size_t i) {
           lsk::PathState& path = paths[order[i]];
           if (path.alive != 0) path.switched = lsk::throughput_switched(path.throughput, switched.threshold);
         });
@@ -250,7 +249,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       if (active.empty()) break;
 
       // Shade: emission found, a light sample for next-event estimation, the next direction.
-      tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
+      ls::parallel_for(size_t(0), active.size(), [&](size_t i) {
         const uint32_t p = active[i];
         shading.shade_path(p, sample, bounce, batch_hits[i], paths[p], image[p], dropped[p]);
       });
@@ -258,7 +257,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
       // Trace this bounce's shadow rays (any hit) and add the light they let through.
       stats.shadow_rays += trace_selected([&](uint32_t p) { return paths[p].has_shadow != 0; },
                                           [&](uint32_t p) { return paths[p].shadow_ray; }, true, stats.switched_shadow_rays);
-      tbb::parallel_for(size_t(0), active.size(), [&](size_t i) {
+      ls::parallel_for(size_t(0), active.size(), [&](size_t i) {
         if (batch_hits[i].triangle != lsk::LS_INVALID) return;
         const uint32_t p = active[i];
         shading.add_shadow_light(paths[p], image[p], dropped[p]);

@@ -4,9 +4,8 @@
 #include "kernels/offset_ray.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
+#include "parallel.h"
 #include "surface.h"
-
-#include <tbb/parallel_for.h>
 
 namespace ls {
 
@@ -48,12 +47,12 @@ std::vector<lsk::Ray> generate_rays(const Scene& scene, const Accel& exact, RayK
   std::vector<lsk::Ray> rays(count);
   const lsk::CameraFrame cam = camera_frame(scene.camera, kImageSide, kImageSide);
   if (kind == RayKind::Primary) {
-    tbb::parallel_for(size_t(0), count, [&](size_t i) { rays[i] = primary_ray(cam, seed, uint32_t(i)); });
+    ls::parallel_for(size_t(0), count, [&](size_t i) { rays[i] = primary_ray(cam, seed, uint32_t(i)); });
     return rays;
   }
   if (kind == RayKind::Random) {
     const Bounds b = world_bounds(scene);
-    tbb::parallel_for(size_t(0), count, [&](size_t i) {
+    ls::parallel_for(size_t(0), count, [&](size_t i) {
       const uint32_t k = uint32_t(i);
       glm::vec3 o;
       for (int a = 0; a < 3; ++a) o[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * lsk::random01(seed, k, 0, 0, uint32_t(a));
@@ -76,7 +75,7 @@ std::vector<lsk::Ray> generate_rays(const Scene& scene, const Accel& exact, RayK
     if (round >= 64) throw InputError("diffuse rays: the camera sees (almost) nothing of this scene");
     std::vector<lsk::Ray> candidates(count);
     std::vector<char> ok(count, 0);
-    tbb::parallel_for(size_t(0), count, [&](size_t i) {
+    ls::parallel_for(size_t(0), count, [&](size_t i) {
       const uint32_t index = uint32_t(round * count + i);
       const lsk::Ray p = primary_ray(cam, seed, index);
       const lsk::Hit h = trace_ray(context, exact, p, false);

@@ -1,19 +1,15 @@
 #!/usr/bin/env bash
-# CI after the README's test command: the suite under ASan + UBSan and a time-boxed libFuzzer run of
-# every harness.  Each in its own build folder (build/asan, build/tsan, build/fuzz), so the release
-# build is never touched.  docs/robustness.md explains it.
+# CI after the README's test command: the suite under ASan + UBSan, the threaded tests under TSan and
+# a time-boxed libFuzzer run of every harness.  Each in its own build folder (build/asan, build/tsan,
+# build/fuzz), so the release build is never touched.  docs/robustness.md explains it.
 #
-#   scripts/run-sanitizers.sh [asan] [tsan] [fuzz]   (default: asan fuzz)
-#
-# tsan is not a default step: with Debian's uninstrumented libtbb, TSan cannot see TBB's own
-# synchronisation and reports every handover between parallel phases of our code as a race
-# (docs/robustness.md, "Sanitizers"); it is meaningful only against a TSan-built oneTBB.
+#   scripts/run-sanitizers.sh [asan] [tsan] [fuzz]   (default: all three)
 #   FUZZ_SECONDS=600 scripts/run-sanitizers.sh fuzz  (longer local fuzzing; default 60 s per harness)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 steps=("$@")
-((${#steps[@]})) || steps=(asan fuzz)
+((${#steps[@]})) || steps=(asan tsan fuzz)
 fuzz_seconds="${FUZZ_SECONDS:-60}"
 jobs="$(nproc)"
 
@@ -39,8 +35,9 @@ for step in "${steps[@]}"; do
       timed "ASan + UBSan: whole test suite" ctest --preset asan -j "$jobs"
       ;;
     tsan)
-      # Only what runs threads: the TBB builders, trace_rays and the path tracer (label `parallel`).
-      timed "TSan: build" build tsan
+      # Only what runs threads (label `parallel`): the TBB builders, trace_rays, the path tracer, the
+      # numerical extremes, and the checks of the TSan setup itself; the target builds just those.
+      timed "TSan: build" build tsan parallel_tests
       timed "TSan: parallel tests" ctest --preset tsan -j "$jobs"
       ;;
     fuzz)

@@ -19,12 +19,12 @@
 #include "accel.h"
 #include "kernels/offset_ray.h"
 #include "kernels/ray_triangle.h"
+#include "parallel.h"
 #include "scene.h"
 #include "structure_name.h"
 #include "surface.h"
 
 #include <glm/gtc/matrix_transform.hpp>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -285,7 +285,7 @@ lsk::Hit brute(const WorldTris& w, const lsk::Ray& ray) {
 
 std::vector<lsk::Hit> brute_all(const WorldTris& w, const std::vector<lsk::Ray>& rays) {
   std::vector<lsk::Hit> hits(rays.size());
-  tbb::parallel_for(size_t(0), rays.size(), [&](size_t i) { hits[i] = brute(w, rays[i]); });
+  ls::parallel_for(size_t(0), rays.size(), [&](size_t i) { hits[i] = brute(w, rays[i]); });
   return hits;
 }
 
@@ -706,8 +706,8 @@ TEST_CASE("traversal: watertight closed meshes", "[traversal][watertight]") {
         }
       }
       std::vector<char> entering(candidates.size());
-      tbb::parallel_for(size_t(0), candidates.size(),
-                        [&](size_t i) { entering[i] = enters(candidates[i].origin, candidates[i].dir) ? 1 : 0; });
+      ls::parallel_for(size_t(0), candidates.size(),
+                       [&](size_t i) { entering[i] = enters(candidates[i].origin, candidates[i].dir) ? 1 : 0; });
       std::vector<lsk::Ray> rays;
       std::vector<Kind> kinds;
       size_t grazing = 0;
