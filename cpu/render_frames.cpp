@@ -47,26 +47,6 @@ std::string frame_name(int f) {
   return buf;
 }
 
-// Written under a temporary name and renamed: never half a file, also when interrupted.  A pending
-// interrupt stops it before it starts, unless `while_interrupted` (the last listing of a stopped run).
-void write_json(const fs::path& path, const json& j, bool while_interrupted = false) {
-  const std::string target = path.string(), temp = target + ".partial";
-  if (!while_interrupted) throw_if_interrupted();
-  set_partial_file(&temp);
-  {
-    std::ofstream f(temp);
-    f << j.dump(2) << "\n";
-    if (!f) {
-      set_partial_file(nullptr);
-      std::error_code ec;
-      fs::remove(temp, ec);
-      throw InputError("cannot write '" + target + "'");
-    }
-  }
-  fs::rename(temp, target);
-  set_partial_file(nullptr);
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -221,7 +201,7 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
     list["frames_done"] = done.size();
     list["complete"] = complete;
     list["summary"] = summary_json(series);
-    write_json(out / "frames.json", list, while_interrupted);
+    write_json_file((out / "frames.json").string(), list, while_interrupted);
     listed = done.size();
     listed_at = std::chrono::steady_clock::now();
   };

@@ -123,9 +123,9 @@ nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& 
   return report;
 }
 
-void write_json_file(const std::string& path, const nlohmann::json& report) {
+void write_json_file(const std::string& path, const nlohmann::json& report, bool while_interrupted) {
   const std::string temp = path + ".partial";
-  throw_if_interrupted();
+  if (!while_interrupted) throw_if_interrupted();
   set_partial_file(&temp);
   {
     std::ofstream f(temp);

@@ -25,10 +25,11 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
 nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context);
 
 // The parts of write_render_outputs: the folder, the images (total.exr, bounce_K.exr, image.png) and
-// a JSON file, each written to a temporary name and renamed (interrupt.h).
+// a JSON file, each written to a temporary name and renamed (interrupt.h).  A pending interrupt stops
+// a JSON file before it starts, unless `while_interrupted` (the last listing of a stopped run).
 void create_output_folder(const std::string& dir);
 void write_render_images(const std::string& dir, const RenderResult& result);
-void write_json_file(const std::string& path, const nlohmann::json& json);
+void write_json_file(const std::string& path, const nlohmann::json& json, bool while_interrupted = false);
 
 // Line Space counters as report keys: prefix + lookups, empty, accepted, refused_angle, ...
 void put_ls_counters(nlohmann::json& into, const std::string& prefix, const lsk::LsCounters& counters);
