@@ -1,11 +1,19 @@
+// The binned SAH builder.  Its trees are bit for bit those of the plain formulation (bin the
+// centroids, sweep every boundary, std::partition, recurse; tests/test_bvh.cpp recomputes every
+// split by brute force): the speed comes from doing the same work with less memory traffic —
+// primitives moved with their boxes, each side's bounds gathered while partitioning, only occupied
+// bins swept, 4-float SIMD for the box arithmetic, small subtrees laid out directly.
 #include "bvh_builder.h"
 
 #include "interrupt.h"
 #include "parallel.h"
+#include "simd.h"
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
+#include <limits>
 #include <memory>
 
 namespace ls {
@@ -20,48 +28,137 @@ float half_area(const Bounds& b) {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
+// A node above the serially built subtrees (ranges over kParallelRange), kept until the tree is
+// complete and laid out depth first.
 struct TempNode {
   Bounds box;
   uint32_t begin = 0, end = 0;
   std::unique_ptr<TempNode> left, right;
+  // Or, for a range built serially, its whole subtree already laid out depth first from index 0
+  // (inner nodes' `first` relative to that array).
+  std::vector<lsk::BvhNode> subtree;
 };
 
+// A primitive as the builder moves it: its box and input index side by side, so that binning and
+// partitioning read memory in order instead of gathering through an index array.  Its two halves are
+// loaded as 4-float batches; `id` sits in lo's fourth lane and is masked off before any arithmetic.
+struct alignas(16) PrimRef {
+  glm::vec3 lo;
+  uint32_t id;
+  glm::vec3 hi;
+  float zero = 0.0f;
+  Float4 lo4() const { return xsimd::bitwise_and(Float4::load_aligned(&lo.x), xyz_mask()); }
+  Float4 hi4() const { return Float4::load_aligned(&hi.x); }
+  static Float4 xyz_mask() {
+    alignas(16) static constexpr int32_t bits[4] = {-1, -1, -1, 0};
+    return xsimd::bitwise_cast<Float4>(Int4::load_aligned(bits));
+  }
+};
+
+// Bounds::centre's arithmetic, 0.5f * (lo + hi), in all lanes at once.
+Float4 centre4(const Float4& lo, const Float4& hi) { return Float4(0.5f) * (lo + hi); }
+
+Bounds to_bounds(const Float4& lo, const Float4& hi) {
+  alignas(16) float l[4], h[4];
+  lo.store_aligned(l);
+  hi.store_aligned(h);
+  Bounds b;
+  b.lo = glm::vec3(l[0], l[1], l[2]);
+  b.hi = glm::vec3(h[0], h[1], h[2]);
+  return b;
+}
+
+// Bounds::grow by a box, lane by lane (glm's min and max, see simd.h).
+struct Box4 {
+  Float4 lo = Float4(std::numeric_limits<float>::infinity());  // (), not {}: {} is xsimd's lane list
+  Float4 hi = Float4(-std::numeric_limits<float>::infinity());
+  void grow(const Float4& l, const Float4& h) {
+    lo = glm_min(lo, l);
+    hi = glm_max(hi, h);
+  }
+};
+
+// half_area of a box, as the scalar rule: 0 when empty (lo.x > hi.x), else e.x * e.y + e.y * e.z +
+// e.z * e.x of its extent.
+float half_area4(const Box4& b) {
+  alignas(16) float lo[4], hi[4], e[4];
+  b.lo.store_aligned(lo);
+  b.hi.store_aligned(hi);
+  if (lo[0] > hi[0]) return 0.0f;
+  (b.hi - b.lo).store_aligned(e);
+  return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
+// Per axis and bin, the box and the number of the primitives whose centroid falls in it, for the
+// bins set in the axis' `occupied` mask; the others are not initialised (a set is 9 KB, a small range
+// touches a few of its bins).
 struct BinSet {
-  std::array<std::array<Bounds, kMaxBins>, 3> box;
-  std::array<std::array<uint32_t, kMaxBins>, 3> count{};
-  void merge(const BinSet& o, int bins) {
+  struct alignas(16) Box {
+    float lo[4], hi[4];
+  };
+  std::array<std::array<Box, kMaxBins>, 3> box;
+  std::array<std::array<uint32_t, kMaxBins>, 3> count;
+  std::array<uint64_t, 3> occupied{};
+  void add(int a, int b, const Float4& lo, const Float4& hi, uint32_t n) {
+    const uint64_t bit = uint64_t(1) << b;
+    Box& bb = box[a][b];
+    if (occupied[a] & bit) {
+      glm_min(Float4::load_aligned(bb.lo), lo).store_aligned(bb.lo);
+      glm_max(Float4::load_aligned(bb.hi), hi).store_aligned(bb.hi);
+      count[a][b] += n;
+    } else {
+      // The first: what growing an empty box by it gives (min(+inf, x) is x for every non-NaN x, -0
+      // included; scene validation refuses NaN).
+      occupied[a] |= bit;
+      lo.store_aligned(bb.lo);
+      hi.store_aligned(bb.hi);
+      count[a][b] = n;
+    }
+  }
+  void merge(const BinSet& o) {
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < bins; ++b) {
-        box[a][b].grow(o.box[a][b]);
-        count[a][b] += o.count[a][b];
+      for (uint64_t m = o.occupied[a]; m; m &= m - 1) {
+        const int b = std::countr_zero(m);
+        add(a, b, Float4::load_aligned(o.box[a][b].lo), Float4::load_aligned(o.box[a][b].hi), o.count[a][b]);
       }
   }
 };
 
+// A range's box and the box of its centroids: what a node needs before it is split.
 struct RangeInfo {
-  Bounds box, centroids;
-  void merge(const RangeInfo& o) { box.grow(o.box); centroids.grow(o.centroids); }
+  Box4 box4, centroids4;
+  void add(const PrimRef& p) {
+    const Float4 lo = p.lo4(), hi = p.hi4();
+    box4.grow(lo, hi);
+    const Float4 c = centre4(lo, hi);
+    centroids4.grow(c, c);
+  }
+  void merge(const RangeInfo& o) {
+    box4.grow(o.box4.lo, o.box4.hi);
+    centroids4.grow(o.centroids4.lo, o.centroids4.hi);
+  }
+  Bounds box() const { return to_bounds(box4.lo, box4.hi); }
+  Bounds centroids() const { return to_bounds(centroids4.lo, centroids4.hi); }
 };
 
 class Builder {
  public:
   Builder(const std::vector<Bounds>& boxes, const BvhBuildOptions& options)
-      : boxes_(boxes), options_(options), bins_(std::clamp(options.bins, 2, kMaxBins)) {
-    centroids_.resize(boxes.size());
-    order_.resize(boxes.size());
-    for (size_t i = 0; i < boxes.size(); ++i) {
-      centroids_[i] = boxes[i].centre();
-      order_[i] = uint32_t(i);
-    }
+      : options_(options), bins_(std::clamp(options.bins, 2, kMaxBins)), prims_(boxes.size()) {
+    ls::parallel_for(size_t(0), boxes.size(), [&](size_t i) {
+      prims_[i] = PrimRef{boxes[i].lo, uint32_t(i), boxes[i].hi};
+    });
   }
 
   BvhBuildResult run() {
-    std::unique_ptr<TempNode> root = build(0, uint32_t(boxes_.size()), 0);
+    const uint32_t n = uint32_t(prims_.size());
+    std::unique_ptr<TempNode> root = build(0, n, 0, range_info(0, n));
     BvhBuildResult result;
-    result.nodes.reserve(2 * boxes_.size());
+    result.nodes.reserve(2 * prims_.size());
     result.nodes.emplace_back();
     flatten(*root, 0, result.nodes);
-    result.order = std::move(order_);
+    result.order.resize(prims_.size());
+    ls::parallel_for(size_t(0), prims_.size(), [&](size_t i) { result.order[i] = prims_[i].id; });
     result.max_depth = max_depth_.load();
     return result;
   }
@@ -69,10 +166,7 @@ class Builder {
  private:
   RangeInfo range_info(uint32_t begin, uint32_t end) const {
     auto body = [&](const tbb::blocked_range<uint32_t>& r, RangeInfo info) {
-      for (uint32_t i = r.begin(); i != r.end(); ++i) {
-        info.box.grow(boxes_[order_[i]]);
-        info.centroids.grow(centroids_[order_[i]]);
-      }
+      for (uint32_t i = r.begin(); i != r.end(); ++i) info.add(prims_[i]);
       return info;
     };
     if (end - begin <= kParallelRange) return body(tbb::blocked_range<uint32_t>(begin, end), RangeInfo{});
@@ -85,21 +179,30 @@ class Builder {
     return std::clamp(int((c - lo) * scale), 0, bins_ - 1);
   }
 
-  BinSet bin(uint32_t begin, uint32_t end, const Bounds& cb, const glm::vec3& scale) const {
-    auto body = [&](const tbb::blocked_range<uint32_t>& r, BinSet set) {
-      for (uint32_t i = r.begin(); i != r.end(); ++i) {
-        const uint32_t p = order_[i];
-        for (int a = 0; a < 3; ++a) {
-          const int b = bin_of(centroids_[p][a], cb.lo[a], scale[a]);
-          set.box[a][b].grow(boxes_[p]);
-          ++set.count[a][b];
-        }
-      }
-      return set;
-    };
-    if (end - begin <= kParallelRange) return body(tbb::blocked_range<uint32_t>(begin, end), BinSet{});
-    return ls::parallel_reduce(tbb::blocked_range<uint32_t>(begin, end, 4096), BinSet{}, body,
-                               [this](BinSet a, const BinSet& b) { a.merge(b, bins_); return a; });
+  void bin_into(BinSet& set, uint32_t begin, uint32_t end, const Bounds& cb, const glm::vec3& scale) const {
+    alignas(16) const float lo_lanes[4] = {cb.lo.x, cb.lo.y, cb.lo.z, 0.0f}, scale_lanes[4] = {scale.x, scale.y, scale.z, 0.0f};
+    const Float4 lo4 = Float4::load_aligned(lo_lanes), scale4 = Float4::load_aligned(scale_lanes);
+    const int last = bins_ - 1;
+    for (uint32_t i = begin; i != end; ++i) {
+      const PrimRef& p = prims_[i];
+      const Float4 lo = p.lo4(), hi = p.hi4();
+      // bin_of on three lanes: the truncation is cvttps's, the clamp the scalar one.
+      alignas(16) int32_t b[4];
+      xsimd::to_int((centre4(lo, hi) - lo4) * scale4).store_aligned(b);
+      for (int a = 0; a < 3; ++a) set.add(a, std::clamp(b[a], 0, last), lo, hi, 1);
+    }
+  }
+
+  // Fills `set` (serially for small ranges: no copies of the 5 KB set).
+  void bin(BinSet& set, uint32_t begin, uint32_t end, const Bounds& cb, const glm::vec3& scale) const {
+    if (end - begin <= kParallelRange) return bin_into(set, begin, end, cb, scale);
+    set = ls::parallel_reduce(
+        tbb::blocked_range<uint32_t>(begin, end, 4096), BinSet{},
+        [&](const tbb::blocked_range<uint32_t>& r, BinSet part) {
+          bin_into(part, r.begin(), r.end(), cb, scale);
+          return part;
+        },
+        [](BinSet a, const BinSet& b) { a.merge(b); return a; });
   }
 
   // Splits at the object median along the widest centroid axis (ties by index: deterministic).
@@ -107,92 +210,173 @@ class Builder {
     const glm::vec3 e = cb.extent();
     const int axis = (e.x >= e.y && e.x >= e.z) ? 0 : (e.y >= e.z ? 1 : 2);
     const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](uint32_t a, uint32_t b) {
-      const float ca = centroids_[a][axis], cb2 = centroids_[b][axis];
-      return ca < cb2 || (ca == cb2 && a < b);
-    });
+    std::nth_element(prims_.begin() + begin, prims_.begin() + mid, prims_.begin() + end,
+                     [&](const PrimRef& a, const PrimRef& b) {
+                       const float ca = 0.5f * (a.lo[axis] + a.hi[axis]), cb2 = 0.5f * (b.lo[axis] + b.hi[axis]);
+                       return ca < cb2 || (ca == cb2 && a.id < b.id);
+                     });
     return mid;
   }
 
-  // The SAH split position, or `end` when no split beats a leaf of an acceptable size.
-  uint32_t sah_split(uint32_t begin, uint32_t end, const RangeInfo& info) {
+  // Moves the primitives `in_left` accepts before the others, in std::partition's order (the
+  // bidirectional swap loop of libstdc++, which the trees documented so far were built with), and
+  // gathers each side's RangeInfo on the way: no second pass over the range.
+  template <class InLeft>
+  uint32_t partition(uint32_t begin, uint32_t end, InLeft in_left, RangeInfo& left, RangeInfo& right) {
+    PrimRef* first = prims_.data() + begin;
+    PrimRef* last = prims_.data() + end;
+    while (true) {
+      while (true) {
+        if (first == last) return uint32_t(first - prims_.data());
+        if (!in_left(*first)) break;
+        left.add(*first++);
+      }
+      --last;
+      while (true) {
+        if (first == last) {
+          right.add(*first);
+          return uint32_t(first - prims_.data());
+        }
+        if (in_left(*last)) break;
+        right.add(*last--);
+      }
+      std::swap(*first, *last);
+      left.add(*first++);
+      right.add(*last);
+    }
+  }
+
+  // The SAH split position, or `end` when no split beats a leaf of an acceptable size; `left` and
+  // `right` receive the sides' RangeInfo when it splits.
+  uint32_t sah_split(uint32_t begin, uint32_t end, const RangeInfo& info, RangeInfo& left, RangeInfo& right) {
     const uint32_t n = end - begin;
-    const Bounds& cb = info.centroids;
+    const Bounds cb = info.centroids();
     glm::vec3 scale(0.0f);
     for (int a = 0; a < 3; ++a) {
       const float ext = cb.hi[a] - cb.lo[a];
       scale[a] = ext > 0.0f ? float(bins_) * 0.99999f / ext : 0.0f;
     }
     if (scale == glm::vec3(0.0f)) return end;  // all centroids coincide
-    const BinSet set = bin(begin, end, cb, scale);
+    BinSet set;
+    bin(set, begin, end, cb, scale);
 
     float best_cost = std::numeric_limits<float>::infinity();
     int best_axis = -1, best_bin = 0;
     for (int a = 0; a < 3; ++a) {
       if (scale[a] == 0.0f) continue;
-      std::array<float, kMaxBins> right_cost{};
-      Bounds acc;
+      // Boundaries right after an occupied bin, in bin order.  The boundary after an empty bin moves
+      // nothing across: it costs what the one before it costs, and the earlier wins the tie, so
+      // only occupied bins are swept; the right side of bin[j]'s boundary is bins[j+1..].
+      std::array<int, kMaxBins> bins;
+      int k = 0;
+      for (uint64_t m = set.occupied[a]; m; m &= m - 1) bins[k++] = std::countr_zero(m);
+      std::array<float, kMaxBins> right_cost;  // [1, k) written before read
+      auto grow = [&](Box4& acc, int bin) {
+        acc.grow(Float4::load_aligned(set.box[a][bin].lo), Float4::load_aligned(set.box[a][bin].hi));
+      };
+      Box4 acc;
       uint32_t count = 0;
-      for (int b = bins_ - 1; b > 0; --b) {
-        acc.grow(set.box[a][b]);
-        count += set.count[a][b];
-        right_cost[b] = half_area(acc) * float(count);
+      for (int j = k - 1; j > 0; --j) {
+        grow(acc, bins[j]);
+        count += set.count[a][bins[j]];
+        right_cost[j] = half_area4(acc) * float(count);
       }
-      acc = Bounds{};
+      acc = Box4{};
       count = 0;
-      for (int b = 0; b < bins_ - 1; ++b) {
-        acc.grow(set.box[a][b]);
-        count += set.count[a][b];
-        if (count == 0 || count == n) continue;
-        const float cost = half_area(acc) * float(count) + right_cost[b + 1];
-        if (cost < best_cost) { best_cost = cost; best_axis = a; best_bin = b; }
+      for (int j = 0; j + 1 < k; ++j) {
+        grow(acc, bins[j]);
+        count += set.count[a][bins[j]];
+        const float cost = half_area4(acc) * float(count) + right_cost[j + 1];
+        if (cost < best_cost) { best_cost = cost; best_axis = a; best_bin = bins[j]; }
       }
     }
     if (best_axis < 0) return end;
-    const float parent_area = half_area(info.box);
+    const float parent_area = half_area(info.box());
     const float split_cost = parent_area > 0.0f ? options_.traversal_cost + best_cost / parent_area : float(n);
     if (n <= uint32_t(options_.max_leaf_size) && float(n) <= split_cost) return begin;  // a leaf is cheaper
     const float lo = cb.lo[best_axis], sc = scale[best_axis];
-    auto mid = std::partition(order_.begin() + begin, order_.begin() + end,
-                              [&](uint32_t p) { return bin_of(centroids_[p][best_axis], lo, sc) <= best_bin; });
-    return uint32_t(mid - order_.begin());
+    auto in_left = [&](const PrimRef& p) { return bin_of(0.5f * (p.lo[best_axis] + p.hi[best_axis]), lo, sc) <= best_bin; };
+    return partition(begin, end, in_left, left, right);
   }
 
-  std::unique_ptr<TempNode> build(uint32_t begin, uint32_t end, int depth) {
+  // Where the range splits: a position in (begin, end), with the sides' RangeInfo, or `begin` when
+  // the range stays a leaf.
+  uint32_t split(uint32_t begin, uint32_t end, int depth, const RangeInfo& info, RangeInfo& left, RangeInfo& right) {
+    int seen = max_depth_.load(std::memory_order_relaxed);
+    while (depth > seen && !max_depth_.compare_exchange_weak(seen, depth)) {}
+    const uint32_t n = end - begin;
+    if (n <= 1) return begin;
+    uint32_t mid;
+    if (depth >= options_.sah_depth_limit) {
+      if (n <= uint32_t(options_.max_leaf_size)) return begin;
+      mid = median_split(begin, end, info.centroids());
+    } else {
+      mid = sah_split(begin, end, info, left, right);
+      if (mid == begin) return begin;  // SAH prefers a leaf
+      if (mid != end) return mid;      // sides gathered by the partition
+      if (n <= uint32_t(options_.max_leaf_size)) return begin;  // inseparable centroids
+      mid = median_split(begin, end, info.centroids());
+    }
+    left = range_info(begin, mid);
+    right = range_info(mid, end);
+    return mid;
+  }
+
+  std::unique_ptr<TempNode> build(uint32_t begin, uint32_t end, int depth, const RangeInfo& info) {
     auto node = std::make_unique<TempNode>();
     node->begin = begin;
     node->end = end;
-    int seen = max_depth_.load();
-    while (depth > seen && !max_depth_.compare_exchange_weak(seen, depth)) {}
-    const RangeInfo info = range_info(begin, end);
-    node->box = info.box;
-    const uint32_t n = end - begin;
-    if (n <= 1) return node;
-
-    uint32_t mid;
-    if (depth >= options_.sah_depth_limit) {
-      if (n <= uint32_t(options_.max_leaf_size)) return node;
-      mid = median_split(begin, end, info.centroids);
-    } else {
-      mid = sah_split(begin, end, info);
-      if (mid == begin) return node;  // SAH prefers a leaf
-      if (mid == end) {               // inseparable centroids
-        if (n <= uint32_t(options_.max_leaf_size)) return node;
-        mid = median_split(begin, end, info.centroids);
-      }
+    node->box = info.box();
+    if (end - begin <= kParallelRange) {
+      node->subtree.emplace_back();
+      build_serial(begin, end, depth, info, 0, node->subtree);
+      return node;
     }
-    if (n > kParallelRange) {
-      throw_if_interrupted();  // large subtrees only: the check costs nothing beside their work
-      ls::parallel_invoke([&] { node->left = build(begin, mid, depth + 1); },
-                          [&] { node->right = build(mid, end, depth + 1); });
-    } else {
-      node->left = build(begin, mid, depth + 1);
-      node->right = build(mid, end, depth + 1);
-    }
+    RangeInfo left, right;
+    const uint32_t mid = split(begin, end, depth, info, left, right);
+    if (mid == begin) return node;
+    throw_if_interrupted();  // large subtrees only: the check costs nothing beside their work
+    ls::parallel_invoke([&] { node->left = build(begin, mid, depth + 1, left); },
+                        [&] { node->right = build(mid, end, depth + 1, right); });
     return node;
   }
 
+  // Builds the range's subtree into `nodes` at `index`, children appended in pairs, depth first.
+  void build_serial(uint32_t begin, uint32_t end, int depth, const RangeInfo& info, uint32_t index,
+                    std::vector<lsk::BvhNode>& nodes) {
+    RangeInfo left, right;
+    const uint32_t mid = split(begin, end, depth, info, left, right);
+    lsk::BvhNode& out = nodes[index];
+    const Bounds box = info.box();
+    out.lo = box.lo;
+    out.hi = box.hi;
+    if (mid == begin) {
+      out.first = begin;
+      out.count = end - begin;
+      return;
+    }
+    const uint32_t child = uint32_t(nodes.size());
+    out.first = child;
+    out.count = 0;
+    nodes.emplace_back();
+    nodes.emplace_back();  // may reallocate: `out` is not used below
+    build_serial(begin, mid, depth + 1, left, child, nodes);
+    build_serial(mid, end, depth + 1, right, child + 1, nodes);
+  }
+
+  // Lays the tree out depth first, children in adjacent pairs: a serially built subtree is copied
+  // with its inner nodes' child indices moved to where it lands.
   void flatten(const TempNode& temp, uint32_t index, std::vector<lsk::BvhNode>& nodes) const {
+    if (!temp.subtree.empty()) {
+      const uint32_t base = uint32_t(nodes.size()) - 1;  // local index k >= 1 lands at base + k
+      auto moved = [base](lsk::BvhNode node) {
+        if (node.count == 0) node.first += base;
+        return node;
+      };
+      nodes[index] = moved(temp.subtree[0]);
+      for (size_t k = 1; k < temp.subtree.size(); ++k) nodes.push_back(moved(temp.subtree[k]));
+      return;
+    }
     lsk::BvhNode& out = nodes[index];
     out.lo = temp.box.lo;
     out.hi = temp.box.hi;
@@ -210,11 +394,9 @@ class Builder {
     flatten(*temp.right, left + 1, nodes);
   }
 
-  const std::vector<Bounds>& boxes_;
   BvhBuildOptions options_;
   int bins_;
-  std::vector<glm::vec3> centroids_;
-  std::vector<uint32_t> order_;
+  std::vector<PrimRef> prims_;
   std::atomic<int> max_depth_{0};
 };
 

@@ -4,7 +4,7 @@
 #include "parallel.h"
 #include "wide_bvh.h"
 
-#include <xsimd/xsimd.hpp>
+#include "simd.h"
 
 #include <bit>
 
@@ -25,13 +25,7 @@ using SimdArch = xsimd::neon64;
 using FloatBatch = xsimd::batch<float, SimdArch>;
 
 // Triangles are tested four at a time (a leaf holds at most four, unless they cannot be separated).
-#if XSIMD_WITH_SSE2
-using TriArch = xsimd::sse2;
-#else
-using TriArch = SimdArch;
-#endif
-using Tri4 = xsimd::batch<float, TriArch>;
-using Int4 = xsimd::batch<int32_t, TriArch>;
+using Tri4 = Float4;
 static_assert(Tri4::size == 4, "triangle blocks hold four triangles");
 
 Traversal parse_traversal(const std::string& text) {
@@ -52,19 +46,6 @@ using lsk::Hit;
 using lsk::LS_INVALID;
 using lsk::uint;
 using lsk::vec3;
-
-// glm::min / glm::max lane by lane, NaN and signed-zero behaviour included (y < x ? y : x and
-// x < y ? y : x), so each lane equals lsk::ray_box bit for bit.  x86's minps(a, b) is a < b ? a : b
-// and maxps(a, b) is a > b ? a : b: with the operands swapped they are exactly glm's.
-#if XSIMD_WITH_SSE2
-inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::min(y, x); }
-inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::max(y, x); }
-inline Tri4 glm_max4(const Tri4& x, const Tri4& y) { return xsimd::max(y, x); }
-#else
-inline FloatBatch glm_min(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(y < x, y, x); }
-inline FloatBatch glm_max(const FloatBatch& x, const FloatBatch& y) { return xsimd::select(x < y, y, x); }
-inline Tri4 glm_max4(const Tri4& x, const Tri4& y) { return xsimd::select(x < y, y, x); }
-#endif
 
 // The per-ray constants of the box tests.
 struct BoxRay {
@@ -136,7 +117,7 @@ inline Tri4 scale_pow2_lanes(const Tri4& x, const Int4& e, const Tri4& pow2_e) {
 }
 
 inline Tri4 max_abs_lanes(const Tri4& x, const Tri4& y, const Tri4& z) {
-  return glm_max4(glm_max4(xsimd::abs(x), xsimd::abs(y)), xsimd::abs(z));
+  return glm_max(glm_max(xsimd::abs(x), xsimd::abs(y)), xsimd::abs(z));
 }
 
 // The first half of lsk::ray_triangle on four triangles at once: translate, scale by the power of two,
@@ -148,7 +129,7 @@ inline unsigned maybe_hit_lanes(const TriBlock& block, const lsk::TriRay& r) {
   Tri4 d[3][3];  // translated vertices: d[vertex][axis]
   for (int k = 0; k < 3; ++k)
     for (int a = 0; a < 3; ++a) d[k][a] = Tri4::load_aligned(block.v[k][a]) - Tri4(r.origin[a]);
-  const Tri4 m = glm_max4(glm_max4(max_abs_lanes(d[0][0], d[0][1], d[0][2]), max_abs_lanes(d[1][0], d[1][1], d[1][2])),
+  const Tri4 m = glm_max(glm_max(max_abs_lanes(d[0][0], d[0][1], d[0][2]), max_abs_lanes(d[1][0], d[1][1], d[1][2])),
                           max_abs_lanes(d[2][0], d[2][1], d[2][2]));
   // unit_exponent(m) = clamp(-float_exponent(m), -126, 126); lanes with m == 0 end as zero edges.
   const Int4 neg_exp = Int4(127) - ((xsimd::bitwise_cast<Int4>(m) >> 23) & Int4(255));

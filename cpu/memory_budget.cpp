@@ -12,9 +12,9 @@ namespace {
 
 std::string mib(double bytes) { return std::to_string(uint64_t(std::ceil(bytes / double(1 << 20)))) + " MiB"; }
 
-// Per triangle while building: the triangle (48 B), its id and instance (8 B), its box and the
-// builder's order and centroid arrays (~64 B), the flat build's world copy (48 B); per node 32 B, at
-// most 2 nodes per triangle.
+// Per triangle while building: the triangle (48 B), its id and instance (8 B), its box, the builder's
+// primitive reference and the order it returns (24 + 32 + 4 B, ~64 B), the flat build's world copy
+// (48 B); per node 32 B, at most 2 nodes per triangle.
 constexpr double kBytesPerTriangle = 48 + 8 + 64 + 48 + 2 * sizeof(lsk::BvhNode);
 // A Line Space adds per triangle its octahedral vertex normals (16 B) and per BVH node its LS index.
 constexpr double kLsBytesPerTriangle = sizeof(glm::uvec4) + 2 * sizeof(uint32_t);

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
+#include <limits>
 #include <random>
 #include <set>
 #include <string>
@@ -306,6 +308,132 @@ TEST_CASE("build_bvh: degenerate inputs", "[bvh]") {
       INFO("n = " << n);
       check_build(random_boxes(n, uint32_t(n * 31)));
     }
+  }
+}
+
+namespace {
+
+float half_area_of(const Bounds& b) {
+  if (b.empty()) return 0.0f;
+  const glm::vec3 e = b.extent();
+  return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+// The builder's split rule, recomputed by brute force at every node of `r` above the SAH depth limit:
+// the centroid bins of the node's primitives, the SAH cost of every bin boundary on every axis from
+// the primitives themselves (first minimum in axis, then bin order), the leaf-or-split decision, and
+// that the left child holds exactly the primitives left of the chosen boundary.  Independent of the
+// builder's binning, sweep and partition; the float arithmetic of the costs is the rule's own, so near
+// ties are decided as the builder must decide them.  Returns the number of nodes checked.
+size_t check_sah_choices(const std::vector<Bounds>& boxes, const BvhBuildResult& r, const BvhBuildOptions& o) {
+  const int bins = std::clamp(o.bins, 2, 64);
+  size_t checked = 0;
+  // Each node's primitive range: [first, end) in r.order.
+  std::function<std::pair<uint32_t, uint32_t>(uint32_t, int)> visit = [&](uint32_t index, int depth) {
+    const lsk::BvhNode& node = r.nodes[index];
+    std::pair<uint32_t, uint32_t> range;
+    uint32_t mid = 0;  // where the left child's range ends
+    if (node.count > 0) {
+      range = {node.first, node.first + node.count};
+    } else {
+      const auto left = visit(node.first, depth + 1);
+      const auto right = visit(node.first + 1, depth + 1);
+      REQUIRE(left.second == right.first);
+      range = {left.first, right.second};
+      mid = left.second;
+    }
+    if (depth >= o.sah_depth_limit) return range;
+    const uint32_t n = range.second - range.first;
+    Bounds box, cb;
+    for (uint32_t i = range.first; i < range.second; ++i) {
+      box.grow(boxes[r.order[i]]);
+      cb.grow(boxes[r.order[i]].centre());
+    }
+    glm::vec3 scale(0.0f);
+    for (int a = 0; a < 3; ++a) {
+      const float ext = cb.hi[a] - cb.lo[a];
+      scale[a] = ext > 0.0f ? float(bins) * 0.99999f / ext : 0.0f;
+    }
+    auto bin_of = [&](uint32_t prim, int a) {
+      return std::clamp(int((boxes[prim].centre()[a] - cb.lo[a]) * scale[a]), 0, bins - 1);
+    };
+    float best_cost = std::numeric_limits<float>::infinity();
+    int best_axis = -1, best_bin = 0;
+    for (int a = 0; a < 3 && n > 1; ++a) {
+      if (scale[a] == 0.0f) continue;
+      for (int b = 0; b + 1 < bins; ++b) {
+        Bounds lb, rb;
+        uint32_t lc = 0;
+        for (uint32_t i = range.first; i < range.second; ++i) {
+          const uint32_t p = r.order[i];
+          if (bin_of(p, a) <= b) {
+            lb.grow(boxes[p]);
+            ++lc;
+          } else {
+            rb.grow(boxes[p]);
+          }
+        }
+        if (lc == 0 || lc == n) continue;
+        const float cost = half_area_of(lb) * float(lc) + half_area_of(rb) * float(n - lc);
+        if (cost < best_cost) { best_cost = cost; best_axis = a; best_bin = b; }
+      }
+    }
+    INFO("node " << index << ", depth " << depth << ", " << n << " primitives");
+    if (best_axis < 0) {  // nothing separates the centroids: a leaf unless over the leaf size (median)
+      if (n <= uint32_t(o.max_leaf_size)) CHECK(node.count == n);
+      return range;
+    }
+    const float parent_area = half_area_of(box);
+    const float split_cost = parent_area > 0.0f ? o.traversal_cost + best_cost / parent_area : float(n);
+    const bool leaf = n <= uint32_t(o.max_leaf_size) && float(n) <= split_cost;
+    CHECK(node.count == (leaf ? n : 0u));
+    if (leaf || node.count > 0) return range;
+    bool sides_right = true;
+    for (uint32_t i = range.first; i < range.second; ++i)
+      sides_right = sides_right && (bin_of(r.order[i], best_axis) <= best_bin) == (i < mid);
+    CHECK(sides_right);
+    ++checked;
+    return range;
+  };
+  visit(0, 0);
+  return checked;
+}
+
+}  // namespace
+
+TEST_CASE("build_bvh: every split is the binned SAH's choice, recomputed by brute force", "[bvh]") {
+  struct Case {
+    const char* name;
+    std::vector<Bounds> boxes;
+    BvhBuildOptions options;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"random 3000", random_boxes(3000, 11), {}});
+  cases.push_back({"random 9000 (parallel binning above 4096)", random_boxes(9000, 12), {}});
+  cases.push_back({"clustered", random_boxes(2000, 13, 1.0f, 2.0f), {}});
+  BvhBuildOptions few;
+  few.bins = 5;
+  few.max_leaf_size = 1;
+  cases.push_back({"5 bins, leaves of 1", random_boxes(1500, 14), few});
+  BvhBuildOptions costly;
+  costly.traversal_cost = 3.0f;
+  costly.max_leaf_size = 8;
+  cases.push_back({"traversal cost 3, leaves of 8", random_boxes(1500, 15), costly});
+  std::vector<Bounds> grid;  // many equal costs: the first minimum must win
+  for (int i = 0; i < 16; ++i)
+    for (int j = 0; j < 16; ++j)
+      for (int k = 0; k < 8; ++k) grid.push_back(box_of(glm::vec3(float(i), float(j), float(k)), glm::vec3(float(i) + 1.0f, float(j) + 1.0f, float(k) + 1.0f)));
+  cases.push_back({"unit grid 16x16x8", grid, {}});
+  std::vector<Bounds> signed_zero = random_boxes(500, 16);
+  for (size_t i = 0; i < signed_zero.size(); i += 3) {
+    signed_zero[i].lo.x = (i % 2) ? -0.0f : 0.0f;
+    signed_zero[i].hi.x = std::max(signed_zero[i].hi.x, 0.5f);
+  }
+  cases.push_back({"boxes starting at +0 and -0", signed_zero, {}});
+  for (const Case& c : cases) {
+    INFO(c.name);
+    const BvhBuildResult r = ls::build_bvh(c.boxes, c.options);
+    CHECK(check_sah_choices(c.boxes, r, c.options) > c.boxes.size() / 8);
   }
 }
 
