@@ -14,6 +14,22 @@ struct Collapser {
 
   uint32_t ls_of(uint32_t b) const { return node_ls.empty() ? lsk::LS_INVALID : node_ls[b]; }
 
+  // How many wide nodes collapse(b) makes: one, and those of its bottom-level inner nodes (the vector
+  // is reserved once instead of growing by copies of 320-byte nodes).
+  size_t count(uint32_t b) const {
+    size_t total = 1;
+    std::array<uint32_t, 1 << (K + 1)> at;
+    at.fill(lsk::LS_INVALID);
+    at[1] = b;
+    for (int p = 2; p < (1 << (K + 1)); ++p) {
+      const uint32_t parent = at[size_t(p / 2)];
+      if (parent == lsk::LS_INVALID || nodes[parent].count > 0) continue;
+      at[size_t(p)] = nodes[parent].first + uint32_t(p & 1);
+      if (nodes[at[size_t(p)]].count == 0 && uint32_t(p) >= WideNode<K>::kBottom) total += count(at[size_t(p)]);
+    }
+    return total;
+  }
+
   // The treelet rooted at the binary inner node b, and (depth first) the treelets below it.
   uint32_t collapse(uint32_t b) {
     const uint32_t index = uint32_t(tree.nodes.size());
@@ -60,8 +76,13 @@ WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::v
   WideTree<K> tree;
   tree.wide_of.assign(nodes.size(), lsk::LS_INVALID);
   Collapser<K> c{nodes, node_ls, tree};
+  auto collapsible = [&](uint32_t r) { return r != lsk::LS_INVALID && r < nodes.size() && nodes[r].count == 0; };
+  size_t total = 0;
   for (uint32_t r : roots)
-    if (r != lsk::LS_INVALID && r < nodes.size() && nodes[r].count == 0 && tree.wide_of[r] == lsk::LS_INVALID)
+    if (collapsible(r)) total += c.count(r);  // an upper bound: roots shared by several are counted again
+  tree.nodes.reserve(total);
+  for (uint32_t r : roots)
+    if (collapsible(r) && tree.wide_of[r] == lsk::LS_INVALID)
       c.collapse(r);
   return tree;
 }
