@@ -1,5 +1,6 @@
 #include "accel.h"
 
+#include "huge_pages.h"
 #include "ls_budget.h"
 #include "memory_budget.h"
 #include "top_level_update.h"
@@ -43,8 +44,10 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
   for (size_t i = 0; i < scene.instances.size(); ++i)
     first[i + 1] = first[i] + scene.meshes[scene.instances[i].mesh].triangles.size();
   const size_t total = first.back();
-  std::vector<lsk::Triangle> world(total);
-  std::vector<Bounds> boxes(total);
+  std::vector<lsk::Triangle> world;
+  std::vector<Bounds> boxes;
+  resize_huge(world, total);
+  resize_huge(boxes, total);
   ls::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
     const Instance& inst = scene.instances[i];
     const Mesh& mesh = scene.meshes[inst.mesh];
@@ -60,9 +63,9 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
   BvhBuildResult bvh = build_bvh(boxes, options);
   accel.nodes = std::move(bvh.nodes);
   accel.max_depth = bvh.max_depth;
-  accel.tris.resize(total);
-  accel.tri_ids.resize(total);
-  accel.tri_instances.resize(total);
+  resize_huge(accel.tris, total);
+  resize_huge(accel.tri_ids, total);
+  resize_huge(accel.tri_instances, total);
   ls::parallel_for(size_t(0), total, [&](size_t k) {
     const size_t src = bvh.order[k];
     const size_t inst = size_t(std::upper_bound(first.begin(), first.end(), src) - first.begin()) - 1;
@@ -92,6 +95,14 @@ void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& 
 
   // Concatenate: node and triangle indices become absolute.
   accel.object_roots.assign(scene.meshes.size(), lsk::LS_INVALID);
+  size_t node_total = 0, tri_total = 0;
+  for (const BvhBuildResult& b : object_bvh) {
+    node_total += b.nodes.size();
+    tri_total += b.order.size();
+  }
+  reserve_huge(accel.nodes, node_total);
+  reserve_huge(accel.tris, tri_total);
+  reserve_huge(accel.tri_ids, tri_total);
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     if (object_bvh[m].nodes.empty()) continue;
     const Mesh& mesh = scene.meshes[m];

@@ -5,6 +5,7 @@
 // bins swept, 4-float SIMD for the box arithmetic, small subtrees laid out directly.
 #include "bvh_builder.h"
 
+#include "huge_pages.h"
 #include "interrupt.h"
 #include "parallel.h"
 #include "simd.h"
@@ -144,7 +145,8 @@ struct RangeInfo {
 class Builder {
  public:
   Builder(const std::vector<Bounds>& boxes, const BvhBuildOptions& options)
-      : options_(options), bins_(std::clamp(options.bins, 2, kMaxBins)), prims_(boxes.size()) {
+      : options_(options), bins_(std::clamp(options.bins, 2, kMaxBins)) {
+    resize_huge(prims_, boxes.size());
     ls::parallel_for(size_t(0), boxes.size(), [&](size_t i) {
       prims_[i] = PrimRef{boxes[i].lo, uint32_t(i), boxes[i].hi};
     });
@@ -154,10 +156,10 @@ class Builder {
     const uint32_t n = uint32_t(prims_.size());
     std::unique_ptr<TempNode> root = build(0, n, 0, range_info(0, n));
     BvhBuildResult result;
-    result.nodes.reserve(2 * prims_.size());
+    reserve_huge(result.nodes, 2 * prims_.size());
     result.nodes.emplace_back();
     flatten(*root, 0, result.nodes);
-    result.order.resize(prims_.size());
+    resize_huge(result.order, prims_.size());
     ls::parallel_for(size_t(0), prims_.size(), [&](size_t i) { result.order[i] = prims_[i].id; });
     result.max_depth = max_depth_.load();
     return result;

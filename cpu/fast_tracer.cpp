@@ -1,6 +1,7 @@
 #include "fast_tracer.h"
 
 #include "accel.h"
+#include "huge_pages.h"
 #include "parallel.h"
 #include "wide_bvh.h"
 
@@ -289,7 +290,7 @@ class WideTracer final : public FastTracer {
           node.block[lane] = uint32_t(total);
           total += (node.count[lane] + 3u) / 4u;
         }
-    part->blocks.assign(total, TriBlock{});
+    resize_huge(part->blocks, total);  // zeros: lanes past a leaf's count stay 0
     ls::parallel_for(size_t(0), part->tree.nodes.size(), [&](size_t n) {
       const WideNode<K>& node = part->tree.nodes[n];
       for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)

@@ -1,5 +1,7 @@
 #include "wide_bvh.h"
 
+#include "huge_pages.h"
+
 #include <array>
 #include <cstring>
 
@@ -80,7 +82,7 @@ WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::v
   size_t total = 0;
   for (uint32_t r : roots)
     if (collapsible(r)) total += c.count(r);  // an upper bound: roots shared by several are counted again
-  tree.nodes.reserve(total);
+  reserve_huge(tree.nodes, total);
   for (uint32_t r : roots)
     if (collapsible(r) && tree.wide_of[r] == lsk::LS_INVALID)
       c.collapse(r);
