@@ -3,9 +3,8 @@
 #include "accel.h"
 #include "huge_pages.h"
 #include "parallel.h"
-#include "wide_bvh.h"
-
 #include "simd.h"
+#include "wide_bvh.h"
 
 #include <bit>
 
@@ -16,12 +15,8 @@ namespace ls {
 // 4-wide treelet's 6 boxes, so 8 is the most taken.
 #if XSIMD_WITH_AVX
 using SimdArch = xsimd::avx;
-#elif XSIMD_WITH_SSE2
-using SimdArch = xsimd::sse2;
-#elif XSIMD_WITH_NEON64
-using SimdArch = xsimd::neon64;
 #else
-#error "the fast path needs SSE2, AVX or NEON64 (xsimd)"
+using SimdArch = Simd4Arch;
 #endif
 using FloatBatch = xsimd::batch<float, SimdArch>;
 
