@@ -16,19 +16,32 @@ struct Collapser {
 
   uint32_t ls_of(uint32_t b) const { return node_ls.empty() ? lsk::LS_INVALID : node_ls[b]; }
 
-  // How many wide nodes collapse(b) makes: one, and those of its bottom-level inner nodes (the vector
-  // is reserved once instead of growing by copies of 320-byte nodes).
-  size_t count(uint32_t b) const {
-    size_t total = 1;
-    std::array<uint32_t, 1 << (K + 1)> at;
+  static constexpr int kPositions = 1 << (K + 1);
+
+  // The binary node at each treelet position below the inner node b (heap numbering, 1 = b), or
+  // LS_INVALID where the node above is a leaf or missing.
+  std::array<uint32_t, kPositions> positions(uint32_t b) const {
+    std::array<uint32_t, kPositions> at;
     at.fill(lsk::LS_INVALID);
     at[1] = b;
-    for (int p = 2; p < (1 << (K + 1)); ++p) {
+    for (int p = 2; p < kPositions; ++p) {
       const uint32_t parent = at[size_t(p / 2)];
-      if (parent == lsk::LS_INVALID || nodes[parent].count > 0) continue;
-      at[size_t(p)] = nodes[parent].first + uint32_t(p & 1);
-      if (nodes[at[size_t(p)]].count == 0 && uint32_t(p) >= WideNode<K>::kBottom) total += count(at[size_t(p)]);
+      if (parent != lsk::LS_INVALID && nodes[parent].count == 0) at[size_t(p)] = nodes[parent].first + uint32_t(p & 1);
     }
+    return at;
+  }
+  // A bottom-level position holding an inner node: the treelet continues in a wide node of its own.
+  bool continues(const std::array<uint32_t, kPositions>& at, int p) const {
+    return at[size_t(p)] != lsk::LS_INVALID && nodes[at[size_t(p)]].count == 0;
+  }
+
+  // How many wide nodes collapse(b) makes (the vector is reserved once instead of growing by copies
+  // of 320-byte nodes).
+  size_t count(uint32_t b) const {
+    const std::array<uint32_t, kPositions> at = positions(b);
+    size_t total = 1;
+    for (int p = int(WideNode<K>::kBottom); p < kPositions; ++p)
+      if (continues(at, p)) total += count(at[size_t(p)]);
     return total;
   }
 
@@ -39,16 +52,10 @@ struct Collapser {
     WideNode<K> w;
     std::memset(&w, 0, sizeof(w));
     w.root_ls = ls_of(b);
-    constexpr int kPositions = 1 << (K + 1);
-    std::array<uint32_t, kPositions> at;
-    at.fill(lsk::LS_INVALID);
-    at[1] = b;
-    std::array<uint32_t, kPositions> below{};  // bottom-level inner nodes, collapsed after this one
+    const std::array<uint32_t, kPositions> at = positions(b);
     for (int p = 2; p < kPositions; ++p) {
-      const uint32_t parent = at[size_t(p / 2)];
-      if (parent == lsk::LS_INVALID || nodes[parent].count > 0) continue;
-      const uint32_t c = nodes[parent].first + uint32_t(p & 1);
-      at[size_t(p)] = c;
+      const uint32_t c = at[size_t(p)];
+      if (c == lsk::LS_INVALID) continue;
       const int lane = p - 2;
       const lsk::BvhNode& n = nodes[c];
       for (int a = 0; a < 3; ++a) {
@@ -58,11 +65,10 @@ struct Collapser {
       w.count[lane] = n.count;
       w.first[lane] = n.count > 0 ? n.first : 0u;
       w.ls[lane] = ls_of(c);
-      if (n.count == 0 && uint32_t(p) >= WideNode<K>::kBottom) below[size_t(p)] = 1;
     }
     tree.nodes.push_back(w);
     for (int p = int(WideNode<K>::kBottom); p < kPositions; ++p)
-      if (below[size_t(p)]) {
+      if (continues(at, p)) {
         const uint32_t child = collapse(at[size_t(p)]);
         tree.nodes[index].first[p - 2] = child;
       }
