@@ -1,9 +1,9 @@
 #include "fast_tracer.h"
 
 #include "accel.h"
-#include "huge_pages.h"
-#include "parallel.h"
+#include "exact_wide_bvh.h"
 #include "simd.h"
+#include "triangle_blocks.h"
 #include "wide_bvh.h"
 
 #include <bit>
@@ -19,10 +19,6 @@ using SimdArch = xsimd::avx;
 using SimdArch = Simd4Arch;
 #endif
 using FloatBatch = xsimd::batch<float, SimdArch>;
-
-// Triangles are tested four at a time (a leaf holds at most four, unless they cannot be separated).
-using Tri4 = Float4;
-static_assert(Tri4::size == 4, "triangle blocks hold four triangles");
 
 Traversal parse_traversal(const std::string& text) {
   if (text == "reference") return Traversal::Reference;
@@ -49,6 +45,7 @@ struct BoxRay {
   float inv_dir[3];
   bool parallel[3];  // safe_reciprocal's huge value: the ray runs parallel to that slab
   bool any_parallel;
+  bool near_is_lo[3];  // inv_dir >= 0: the slab is entered through its lower plane
 };
 
 BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
@@ -58,9 +55,17 @@ BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
     r.origin[a] = origin[a];
     r.inv_dir[a] = inv_dir[a];
     r.parallel[a] = std::abs(inv_dir[a]) == big;
+    r.near_is_lo[a] = inv_dir[a] >= 0.0f;
   }
   r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
   return r;
+}
+
+// Rays the order-free walk takes: finite origin, direction and tmin (its slab arithmetic is the
+// reference's only there; anything else follows the reference's order in the treelets).
+bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
+  return std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z) && std::isfinite(dir.x) &&
+         std::isfinite(dir.y) && std::isfinite(dir.z) && !std::isnan(tmin);
 }
 
 // lsk::ray_box for every lane of a wide node: entry distance and widened exit distance; a lane is hit
@@ -69,7 +74,7 @@ BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
 template <int K>
 inline void box_tests(const WideNode<K>& node, const BoxRay& r, float tmin, float tmax, float* tnear, float* tfar) {
   constexpr float big = 3.0e38f;
-  constexpr float slack = 3.81469727e-6f;  // widen_distance's 2^-18
+  constexpr float slack = lsk::LS_WIDEN_SLACK;
   for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
     FloatBatch tn[3];
     FloatBatch tf[3];
@@ -97,70 +102,14 @@ inline void box_tests(const WideNode<K>& node, const BoxRay& r, float tmin, floa
   }
 }
 
-// Four triangles of a leaf in SoA layout: v[vertex][axis][lane].  Lanes past the leaf's count are 0.
-struct alignas(16) TriBlock {
-  float v[3][3][4];
-};
-
-// lsk::scale_pow2(x, e) lane by lane for e in [-126, 126] (what unit_exponent returns): x * 2^e is
-// exact unless the result would be denormal, where the kernel flushes to a signed zero instead; a
-// zero, an infinity or a NaN stays itself.  The kernel's two half-steps give the same exact product.
-inline Tri4 scale_pow2_lanes(const Tri4& x, const Int4& e, const Tri4& pow2_e) {
-  const Int4 field = (xsimd::bitwise_cast<Int4>(x) >> 23) & Int4(255);
-  const auto flush = ((field - Int4(127) + e) < Int4(-126)) && (field != Int4(255));
-  const Int4 bits = xsimd::select(flush, xsimd::bitwise_cast<Int4>(x * Tri4(0.0f)), xsimd::bitwise_cast<Int4>(x * pow2_e));
-  return xsimd::bitwise_cast<Tri4>(bits);
-}
-
-inline Tri4 max_abs_lanes(const Tri4& x, const Tri4& y, const Tri4& z) {
-  return glm_max(glm_max(xsimd::abs(x), xsimd::abs(y)), xsimd::abs(z));
-}
-
-// The first half of lsk::ray_triangle on four triangles at once: translate, scale by the power of two,
-// shear, edge functions; the same operations lane by lane, hence the same values.  Returns a lane
-// mask (bit l) of the triangles the kernel may hit: those whose edge-function signs do not already
-// reject them, and those with a zero edge function (the kernel then recomputes it in double).  The
-// kernel itself decides these, so a hit is the kernel's hit bit for bit.
-inline unsigned maybe_hit_lanes(const TriBlock& block, const lsk::TriRay& r) {
-  Tri4 d[3][3];  // translated vertices: d[vertex][axis]
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) d[k][a] = Tri4::load_aligned(block.v[k][a]) - Tri4(r.origin[a]);
-  const Tri4 m = glm_max(glm_max(max_abs_lanes(d[0][0], d[0][1], d[0][2]), max_abs_lanes(d[1][0], d[1][1], d[1][2])),
-                          max_abs_lanes(d[2][0], d[2][1], d[2][2]));
-  // unit_exponent(m) = clamp(-float_exponent(m), -126, 126); lanes with m == 0 end as zero edges.
-  const Int4 neg_exp = Int4(127) - ((xsimd::bitwise_cast<Int4>(m) >> 23) & Int4(255));
-  const Int4 ks = xsimd::select(neg_exp > Int4(126), Int4(126), xsimd::select(neg_exp < Int4(-126), Int4(-126), neg_exp));
-  const Tri4 pow2_ks = xsimd::bitwise_cast<Tri4>((ks + Int4(127)) << 23);
-  Tri4 sx[3];
-  Tri4 sy[3];
-  const Tri4 shear_x(r.sx);
-  const Tri4 shear_y(r.sy);
-  for (int k = 0; k < 3; ++k) {
-    const Tri4 px = scale_pow2_lanes(d[k][r.kx], ks, pow2_ks);
-    const Tri4 py = scale_pow2_lanes(d[k][r.ky], ks, pow2_ks);
-    const Tri4 pz = scale_pow2_lanes(d[k][r.kz], ks, pow2_ks);
-    sx[k] = px - shear_x * pz;
-    sy[k] = py - shear_y * pz;
-  }
-  const Tri4 eu = sx[2] * sy[1] - sy[2] * sx[1];
-  const Tri4 ev = sx[0] * sy[2] - sy[0] * sx[2];
-  const Tri4 ew = sx[1] * sy[0] - sy[1] * sx[0];
-  const Tri4 zero(0.0f);
-  const auto any_zero = (eu == zero) || (ev == zero) || (ew == zero);
-  const auto rejected = ((eu < zero) || (ev < zero) || (ew < zero)) && ((eu > zero) || (ev > zero) || (ew > zero));
-  const auto maybe = any_zero || !rejected;
-  alignas(16) bool lanes[4];
-  maybe.store_aligned(lanes);
-  return unsigned(lanes[0]) | unsigned(lanes[1]) << 1 | unsigned(lanes[2]) << 2 | unsigned(lanes[3]) << 3;
-}
-
 // What a node visit asks of the traversal.
 enum class Visit { Descend, Skip, Stop };
 
 // The reference's loop (trace_bvh / trace_two_level), node for node, on a wide tree.  Starts at the
-// treelet root of wide node w (its box already tested by the caller).  visit(ls, leaf, first, count)
-// is called for every node the reference visits: an inner node (leaf = false) is descended only on
-// Visit::Descend; Visit::Stop ends the walk and returns true.
+// treelet root of wide node w (its box already tested by the caller).  visit(ls, leaf, first, count,
+// block, entry) is called for every node the reference visits (entry: an inner node's order-free
+// entry, exact_wide_bvh.h): an inner node (leaf = false) is descended only on Visit::Descend;
+// Visit::Stop ends the walk and returns true.
 //
 // Each wide node's boxes are tested once, when the walk enters it, against the current t = h0; later
 // decisions at its inner positions (after a pop, with a smaller current t = h) reuse them.  This is
@@ -190,7 +139,7 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
     const uint lane = pos - 2;
     const bool leaf = !root && node.count[lane] > 0;
     const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u,
-                          leaf ? node.block[lane] : LS_INVALID);
+                          leaf ? node.block[lane] : LS_INVALID, root ? node.root_exact : node.exact[lane]);
     if (v == Visit::Stop) return true;
     if (v == Visit::Descend && !leaf) {
       if (root) {
@@ -256,12 +205,141 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
   }
 }
 
-// What the fast path keeps of the object level: the wide trees of the object BVHs (or of the flat
-// BVH) and the SoA triangle blocks.  Shared by the tracers of every top level (animation).
+// ray_box on the four children of an exact wide node against [tmin, tmax]: the lanes hit (bit l) and
+// their entry distances.  The scalar kernel's arithmetic, except that each slab's entry and exit are
+// taken from the plane the ray's direction says instead of as min and max of the two: for a finite
+// ray the same values (rounding is monotone), up to the sign of a zero, which no comparison sees.
+LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode& node, const BoxRay& r, float tmin, float tmax, float* tnear) {
+  constexpr float big = 3.0e38f;
+  constexpr float slack = lsk::LS_WIDEN_SLACK;
+  Float4 tn[3];
+  Float4 tf[3];
+  for (int a = 0; a < 3; ++a) {
+    const Float4 o(r.origin[a]);
+    if (r.any_parallel && r.parallel[a]) {
+      const Float4 lo = Float4::load_aligned(node.lo[a]);
+      const Float4 hi = Float4::load_aligned(node.hi[a]);
+      const auto inside = (o >= lo) && (o <= hi);
+      tn[a] = xsimd::select(inside, Float4(-big), Float4(big));
+      tf[a] = xsimd::select(inside, Float4(big), Float4(-big));
+    } else {
+      const Float4 inv(r.inv_dir[a]);
+      const Float4 enter = Float4::load_aligned(r.near_is_lo[a] ? node.lo[a] : node.hi[a]);
+      const Float4 leave = Float4::load_aligned(r.near_is_lo[a] ? node.hi[a] : node.lo[a]);
+      tn[a] = (enter - o) * inv;
+      tf[a] = (leave - o) * inv;
+    }
+  }
+  const Float4 near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], Float4(tmin)));
+  const Float4 far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], Float4(tmax)));
+  const Float4 widened = far + xsimd::abs(far) * Float4(slack);
+  near.store_aligned(tnear);
+  const auto used = Int4::load_aligned(reinterpret_cast<const int32_t*>(node.child)) != Int4(-1);
+  return lane_bits(near <= widened) & lane_bits(used);
+}
+
+// The order-free closest-hit walk below an exact wide node (whose binary node's box the caller has
+// tested): nearest child first, a pending child popped only while its entry distance can still hold
+// something as close as the current hit, as in the reference.
+struct ExactWalk {
+  struct Pending {
+    uint child;
+    uint count;
+    float t;
+  };
+  static constexpr int kStack = 4 * lsk::TraceContext::LS_STACK_SIZE;  // <= 3 more per wide level
+  uint child = 0;  // what the next step visits: a wide node (count 0) or a leaf
+  uint count = 0;
+  int sp = 0;
+  Pending stack[kStack];
+
+  void start(uint entry) {
+    child = entry;
+    count = 0;
+    sp = 0;
+  }
+
+  // The nearest pending child that can still hold something as close as a hit at t; false: none.
+  bool pop(float t) {
+    const float limit = lsk::widen_distance(t);
+    while (sp > 0) {
+      --sp;
+      if (stack[sp].t <= limit) {
+        child = stack[sp].child;
+        count = stack[sp].count;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // Visits the next wide node or leaf; leaf(child, count) tests a leaf's primitives against the
+  // running hit.  Every child the boxes admit starts loading at once.  False when the walk is over.
+  template <class LeafFn, class PrefetchFn>
+  LS_ALWAYS_INLINE bool step(const ExactWideTree& tree, const BoxRay& ray, float tmin, const Hit& hit, LeafFn&& leaf,
+            PrefetchFn&& prefetch_leaf) {
+    if (count != 0u) {
+      leaf(child, count);
+      return pop(hit.t);
+    }
+    const ExactWideNode& node = tree.nodes[child];
+    alignas(16) float tn[4];
+    unsigned lanes = exact_box_tests(node, ray, tmin, hit.t, tn);
+    for (unsigned m = lanes; m != 0u; m &= m - 1u) {
+      const unsigned l = unsigned(std::countr_zero(m));
+      if (node.count[l] == 0u) {
+        const char* p = reinterpret_cast<const char*>(&tree.nodes[node.child[l]]);
+        __builtin_prefetch(p);
+        __builtin_prefetch(p + 64);
+      } else {
+        prefetch_leaf(node.child[l]);
+      }
+    }
+    if (lanes == 0u) return pop(hit.t);
+    const unsigned first = unsigned(std::countr_zero(lanes));
+    lanes &= lanes - 1u;
+    if (lanes == 0u) {  // one child: go on with it
+      child = node.child[first];
+      count = node.count[first];
+      return true;
+    }
+    // Several: push them farthest first (insertion into the top of the stack), go on with the nearest.
+    const int base = sp;
+    for (unsigned l = first;; l = unsigned(std::countr_zero(lanes)), lanes &= lanes - 1u) {
+      int j = sp++;
+      while (j > base && stack[j - 1].t < tn[l]) {
+        stack[j] = stack[j - 1];
+        --j;
+      }
+      stack[j] = Pending{node.child[l], node.count[l], tn[l]};
+      if (lanes == 0u) break;
+    }
+    --sp;
+    child = stack[sp].child;
+    count = stack[sp].count;
+    return true;
+  }
+};
+
+// One ray's whole order-free walk below `entry`.
+template <class LeafFn, class PrefetchFn>
+inline void walk_exact(const ExactWideTree& tree, uint entry, const BoxRay& ray, float tmin, const Hit& hit, LeafFn&& leaf,
+                       PrefetchFn&& prefetch_leaf) {
+  if (hit.t != hit.t) return;  // a NaN tmax: no t is <= it, the reference finds nothing either
+  ExactWalk walk;
+  walk.start(entry);
+  while (walk.step(tree, ray, tmin, hit, leaf, prefetch_leaf)) {
+  }
+}
+
+// What the fast path keeps of the object level: the treelets and the exact wide tree of the object
+// BVHs (or of the flat BVH) and the triangle blocks.  Shared by the tracers of every top level
+// (animation).
 template <int K>
 struct ObjectPart {
+  TriangleBlocks blocks;
+  ExactWideTree exact;
   WideTree<K> tree;
-  std::vector<TriBlock> blocks;
 };
 
 template <int K>
@@ -271,40 +349,20 @@ class WideTracer final : public FastTracer {
     const std::vector<uint32_t> none;
     const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
     auto part = std::make_shared<ObjectPart<K>>();
-    if (two_level_) {
-      part->tree = build_wide_tree<K>(accel.nodes, node_ls, accel.object_roots);
-      top_ = build_wide_tree<K>(accel.top_nodes, none, {0u});
-    } else {
-      part->tree = build_wide_tree<K>(accel.nodes, node_ls, {0u});
-    }
-    // SoA copies of each leaf's triangles, four to a block: offsets first, then filled in parallel.
-    size_t total = 0;
-    for (WideNode<K>& node : part->tree.nodes)
-      for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
-        if (node.count[lane] > 0) {
-          node.block[lane] = uint32_t(total);
-          total += (node.count[lane] + 3u) / 4u;
-        }
-    resize_huge(part->blocks, total);  // zeros: lanes past a leaf's count stay 0
-    ls::parallel_for(size_t(0), part->tree.nodes.size(), [&](size_t n) {
-      const WideNode<K>& node = part->tree.nodes[n];
-      for (int lane = 0; lane < WideNode<K>::kLanes; ++lane)
-        for (uint32_t k = 0; k < node.count[lane]; ++k) {
-          const lsk::Triangle& t = accel.tris[node.first[lane] + k];
-          TriBlock& block = part->blocks[node.block[lane] + k / 4u];
-          const glm::vec4* v[3] = {&t.v0, &t.v1, &t.v2};
-          for (int i = 0; i < 3; ++i)
-            for (int a = 0; a < 3; ++a) block.v[i][a][k % 4u] = (*v[i])[a];
-        }
-    });
+    part->blocks = build_triangle_blocks(accel.nodes, accel.tris);
+    const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
+    part->exact = build_exact_wide_tree(accel.nodes, node_ls, roots, part->blocks.block_of);
+    part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.block_of, part->exact.entry_of);
+    if (two_level_) build_top(accel);
     part_ = std::move(part);
-    blocks_ = part_->blocks.data();
+    blocks_ = part_->blocks.blocks.data();
   }
 
-  // The object part of `other`, a new wide top tree over accel.top_nodes.
+  // The object part of `other`, new wide top trees over accel.top_nodes.
   WideTracer(const WideTracer& other, const Accel& accel)
-      : two_level_(other.two_level_), part_(other.part_), blocks_(other.blocks_),
-        top_(build_wide_tree<K>(accel.top_nodes, {}, {0u})) {}
+      : two_level_(other.two_level_), part_(other.part_), blocks_(other.blocks_) {
+    build_top(accel);
+  }
 
   std::shared_ptr<const FastTracer> with_top_level(const Accel& accel) const override {
     if (!two_level_) return std::make_shared<WideTracer>(*this);
@@ -319,35 +377,56 @@ class WideTracer final : public FastTracer {
       for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], any_hit);
   }
 
-  size_t bytes() const override { return part_->tree.bytes() + top_.bytes() + part_->blocks.size() * sizeof(TriBlock); }
+  size_t bytes() const override {
+    return part_->tree.bytes() + part_->exact.bytes() + part_->blocks.bytes() + top_.bytes() + top_exact_.bytes();
+  }
   int width() const override { return 1 << K; }
 
  private:
-  // lsk::TraceContext::trace_bvh on the wide tree.
+  // The top level: treelets (ordered: Line Space structures and any hit) and the exact wide tree,
+  // whose leaf lanes hold their first instance.
+  void build_top(const Accel& accel) {
+    top_exact_ = build_exact_wide_tree(accel.top_nodes, {}, {0u}, {});
+    top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
+  }
+
+  // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
+  // the order-free walk below the entries it reaches, for closest-hit queries.
   bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, uint instance,
                  bool any_hit, bool use_ls, Hit& hit, uint& hit_prim) const {
     const lsk::TriRay tri_ray = lsk::make_tri_ray(origin, dir);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
-    auto visit = [&](uint ls, bool leaf, uint first, uint count, uint block) {
+    const BoxRay box_ray = make_box_ray(origin, inv_dir);
+    const bool order_free = !any_hit && order_free_ray(origin, dir, tmin);
+    auto visit = [&](uint ls, bool leaf, uint, uint count, uint block, uint entry) {
       if (use_ls && ls != LS_INVALID) {
         const uint answer = c.ls_lookup(ls, origin, dir, inv_dir, tmin, instance, hit, hit_prim);
         if (answer == lsk::TraceContext::LS_ACCEPTED && any_hit) return Visit::Stop;
         if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
       }
-      if (!leaf) return Visit::Descend;
-      const bool stop = block == LS_INVALID ? c.trace_leaf(first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim)
-                                            : trace_leaf(c, block, first, count, tri_ray, tmin, instance, any_hit, hit, hit_prim);
-      return stop ? Visit::Stop : Visit::Skip;
+      if (leaf)
+        return trace_blocks(c, blocks_, block, count, tri_ray, tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
+                                                                                                      : Visit::Skip;
+      if (!order_free || entry == LS_INVALID) return Visit::Descend;
+      walk_exact(
+          part_->exact, entry, box_ray, tmin, hit,
+          [&](uint first_block, uint n) {
+            trace_blocks(c, blocks_, first_block, n, tri_ray, tmin, instance, false, hit, hit_prim);
+          },
+          [&](uint first_block) { prefetch_block(first_block); });
+      return Visit::Skip;
     };
-    const uint w = part_->tree.wide_of[root];
-    if (w == LS_INVALID) {  // a root that is a leaf has no wide node
-      const lsk::BvhNode& node = c.nodes[root];
-      return visit(use_ls ? c.node_ls[root] : LS_INVALID, true, node.first, node.count, LS_INVALID) == Visit::Stop;
-    }
+    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
+    const lsk::BvhNode& node = c.nodes[root];
+    if (node.count > 0)  // a root that is a leaf has no wide node
+      return visit(root_ls, true, node.first, node.count, part_->blocks.block_of[root], LS_INVALID) == Visit::Stop;
+    const uint entry = part_->exact.entry_of[root];
+    if (order_free && entry != LS_INVALID)  // the whole tree below the root is order-free
+      return visit(root_ls, false, 0u, 0u, LS_INVALID, entry) == Visit::Stop;
     auto leaf_block = [&](uint block) { return reinterpret_cast<const char*>(&blocks_[block]); };
-    return walk(part_->tree, w, make_box_ray(origin, inv_dir), tmin, hit, visit, leaf_block);
+    return walk(part_->tree, part_->tree.wide_of[root], box_ray, tmin, hit, visit, leaf_block);
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
@@ -365,60 +444,42 @@ class WideTracer final : public FastTracer {
     if (!lsk::ray_box(ray.origin, inv_dir, ray.tmin, hit.t, c.top_nodes[0].lo, c.top_nodes[0].hi, t_root))
       return lsk::finish_hit(hit);
     const bool use_ls = c.ls_enabled != 0u;
-    auto visit = [&](uint, bool leaf, uint first, uint count, uint) {
-      if (!leaf) return Visit::Descend;
+    auto instances = [&](uint first, uint count) {
       for (uint i = first; i < first + count; ++i) {
         const lsk::InstanceRecord& rec = c.instances[i];
         vec3 o;
         vec3 d;
         c.instance_ray(rec, ray.origin, ray.dir, o, d);
-        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, any_hit, use_ls, hit, prim)) return Visit::Stop;
+        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, any_hit, use_ls, hit, prim)) return true;
       }
-      return Visit::Skip;
+      return false;
     };
-    const uint w = top_.wide_of[0];
-    if (w == LS_INVALID)
-      visit(LS_INVALID, true, c.top_nodes[0].first, c.top_nodes[0].count, LS_INVALID);
+    const lsk::BvhNode& root = c.top_nodes[0];
+    const BoxRay box_ray = make_box_ray(ray.origin, inv_dir);
+    if (root.count > 0)
+      instances(root.first, root.count);
+    else if (!any_hit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no Line Space decision depends on the order
+      walk_exact(top_exact_, top_exact_.entry_of[0], box_ray, ray.tmin, hit, instances, [](uint) {});
     else
-      walk(top_, w, make_box_ray(ray.origin, inv_dir), ray.tmin, hit, visit, [](uint) { return static_cast<const char*>(nullptr); });
+      walk(top_, top_.wide_of[0], box_ray, ray.tmin, hit,
+           [&](uint, bool leaf, uint first, uint count, uint, uint) {
+             if (!leaf) return Visit::Descend;
+             return instances(first, count) ? Visit::Stop : Visit::Skip;
+           },
+           [](uint) { return static_cast<const char*>(nullptr); });
     return lsk::finish_hit(hit);
   }
 
-  // lsk::TraceContext::trace_leaf with the four-lane filter in front: the triangles it cannot rule
-  // out go through the kernel's ray_triangle and offer_hit in the leaf's order, as in the reference.
-  bool trace_leaf(lsk::TraceContext& c, uint block, uint first, uint count, const lsk::TriRay& tri_ray, float tmin,
-                  uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
-    for (uint b = 0; b < count; b += 4u) {
-      unsigned maybe = maybe_hit_lanes(blocks_[block + b / 4u], tri_ray);
-      if (count - b < 4u) maybe &= (1u << (count - b)) - 1u;
-      while (maybe != 0u) {
-        const uint i = first + b + uint(std::countr_zero(maybe));
-        maybe &= maybe - 1u;
-        const TriBlock& blk = blocks_[block + b / 4u];
-        const uint l = i - first - b;
-        // The block holds the very floats of tris[i]: no second memory stream for the survivors.
-        const vec3 p0(blk.v[0][0][l], blk.v[0][1][l], blk.v[0][2][l]);
-        const vec3 p1(blk.v[1][0][l], blk.v[1][1][l], blk.v[1][2][l]);
-        const vec3 p2(blk.v[2][0][l], blk.v[2][1][l], blk.v[2][2][l]);
-        float t;
-        float u;
-        float v;
-        if (lsk::ray_triangle(tri_ray, tmin, hit.t, p0, p1, p2, t, u, v)) {
-          const uint inst = instance == LS_INVALID ? c.tri_instances[i] : instance;
-          if (lsk::offer_hit(t, u, v, inst, c.tri_ids[i], hit)) {
-            hit_prim = i;
-            if (any_hit) return true;
-          }
-        }
-      }
-    }
-    return false;
+  void prefetch_block(uint block) const {
+    const char* p = reinterpret_cast<const char*>(&blocks_[block]);
+    for (size_t line = 0; line < sizeof(TriBlock); line += 64) __builtin_prefetch(p + line);
   }
 
   bool two_level_;
   std::shared_ptr<const ObjectPart<K>> part_;
-  const TriBlock* blocks_ = nullptr;  // part_->blocks.data(): one load less on the hot path
+  const TriBlock* blocks_ = nullptr;  // part_->blocks.blocks.data(): one load less on the hot path
   WideTree<K> top_;
+  ExactWideTree top_exact_;
 };
 
 }  // namespace

@@ -4,6 +4,10 @@
 
 #include <xsimd/xsimd.hpp>
 
+// The hot path's helpers are inlined whatever the compiler's budget says: out of line, their SIMD
+// values go through memory at every call (the ray-stream loop exceeded GCC's budget).
+#define LS_ALWAYS_INLINE inline __attribute__((always_inline))
+
 namespace ls {
 
 // 4 floats: SSE2 on x86-64 (under every LINESPACE_ISA), NEON on aarch64.
@@ -34,6 +38,27 @@ inline Batch glm_max(const Batch& x, const Batch& y) {
   return xsimd::max(y, x);
 #else
   return xsimd::select(x < y, y, x);
+#endif
+}
+
+// Bit l set when lane l of a 4-lane mask is true.
+inline unsigned lane_bits(const xsimd::batch_bool<float, Simd4Arch>& b) {
+#if XSIMD_WITH_SSE2
+  return unsigned(_mm_movemask_ps(b));
+#else
+  alignas(16) bool lanes[4];
+  b.store_aligned(lanes);
+  return unsigned(lanes[0]) | unsigned(lanes[1]) << 1 | unsigned(lanes[2]) << 2 | unsigned(lanes[3]) << 3;
+#endif
+}
+
+inline unsigned lane_bits(const xsimd::batch_bool<int32_t, Simd4Arch>& b) {
+#if XSIMD_WITH_SSE2
+  return unsigned(_mm_movemask_ps(_mm_castsi128_ps(b)));
+#else
+  alignas(16) bool lanes[4];
+  b.store_aligned(lanes);
+  return unsigned(lanes[0]) | unsigned(lanes[1]) << 1 | unsigned(lanes[2]) << 2 | unsigned(lanes[3]) << 3;
 #endif
 }
 

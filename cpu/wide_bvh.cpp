@@ -12,9 +12,14 @@ template <int K>
 struct Collapser {
   const std::vector<lsk::BvhNode>& nodes;
   const std::vector<uint32_t>& node_ls;
+  const std::vector<uint32_t>& block_of;
+  const std::vector<uint32_t>& entry_of;
   WideTree<K>& tree;
 
-  uint32_t ls_of(uint32_t b) const { return node_ls.empty() ? lsk::LS_INVALID : node_ls[b]; }
+  static uint32_t of(const std::vector<uint32_t>& per_node, uint32_t b) {
+    return per_node.empty() ? lsk::LS_INVALID : per_node[b];
+  }
+  uint32_t ls_of(uint32_t b) const { return of(node_ls, b); }
 
   static constexpr int kPositions = 1 << (K + 1);
 
@@ -52,6 +57,7 @@ struct Collapser {
     WideNode<K> w;
     std::memset(&w, 0, sizeof(w));
     w.root_ls = ls_of(b);
+    w.root_exact = of(entry_of, b);
     const std::array<uint32_t, kPositions> at = positions(b);
     for (int p = 2; p < kPositions; ++p) {
       const uint32_t c = at[size_t(p)];
@@ -65,6 +71,8 @@ struct Collapser {
       w.count[lane] = n.count;
       w.first[lane] = n.count > 0 ? n.first : 0u;
       w.ls[lane] = ls_of(c);
+      w.block[lane] = n.count > 0 ? of(block_of, c) : lsk::LS_INVALID;
+      w.exact[lane] = n.count > 0 ? lsk::LS_INVALID : of(entry_of, c);
     }
     tree.nodes.push_back(w);
     for (int p = int(WideNode<K>::kBottom); p < kPositions; ++p)
@@ -80,10 +88,11 @@ struct Collapser {
 
 template <int K>
 WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                            const std::vector<uint32_t>& roots) {
+                            const std::vector<uint32_t>& roots, const std::vector<uint32_t>& block_of,
+                            const std::vector<uint32_t>& entry_of) {
   WideTree<K> tree;
   tree.wide_of.assign(nodes.size(), lsk::LS_INVALID);
-  Collapser<K> c{nodes, node_ls, tree};
+  Collapser<K> c{nodes, node_ls, block_of, entry_of, tree};
   auto collapsible = [&](uint32_t r) { return r != lsk::LS_INVALID && r < nodes.size() && nodes[r].count == 0; };
   size_t total = 0;
   for (uint32_t r : roots)
@@ -96,8 +105,10 @@ WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::v
 }
 
 template WideTree<2> build_wide_tree<2>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
+                                        const std::vector<uint32_t>&, const std::vector<uint32_t>&,
                                         const std::vector<uint32_t>&);
 template WideTree<3> build_wide_tree<3>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
+                                        const std::vector<uint32_t>&, const std::vector<uint32_t>&,
                                         const std::vector<uint32_t>&);
 
 }  // namespace ls

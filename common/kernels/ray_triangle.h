@@ -62,14 +62,30 @@ LS_FN TriRay make_tri_ray(IN(vec3) origin, IN(vec3) dir) {
   return r;
 }
 
-// True when the triangle is hit at a distance in [tmin, tmax] (in units of the unscaled direction);
-// then t, u and v (weights of p1 and p2) are set.
-LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(vec3) p1, IN(vec3) p2,
-                        OUT(float) t, OUT(float) u, OUT(float) v) {
+// The first half of the test: the triangle translated to the ray's origin, scaled and sheared, and
+// its three edge functions.  The CPU's fast path computes the same values four triangles at a time
+// and finishes the survivors with ray_triangle_finish (cpu/triangle_blocks.h).
+struct TriEdges {
+  vec3 a;    // p0 - origin, scaled by 2^ks (the plane distance is taken from it)
+  int ks;
+  float eu;  // edge functions (signed 2-d orientations), exact in sign
+  float ev;
+  float ew;
+  float pad;
+};
+
+// False when the triangle cannot be hit (its vertices coincide with the origin); else e is set.
+LS_FN bool ray_triangle_edges(IN(TriRay) r, IN(vec3) p0, IN(vec3) p1, IN(vec3) p2, OUT(TriEdges) e) {
   precise vec3 a = p0 - r.origin;
   precise vec3 b = p1 - r.origin;
   precise vec3 c = p2 - r.origin;
   float m = max(max(max_abs(a), max_abs(b)), max_abs(c));
+  e.a = vec3(0.0f);
+  e.ks = 0;
+  e.eu = 0.0f;
+  e.ev = 0.0f;
+  e.ew = 0.0f;
+  e.pad = 0.0f;
   if (m == 0.0f) return false;
   int ks = unit_exponent(m);
   a = scale_pow2(a, ks);
@@ -92,8 +108,20 @@ LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(ve
     ev = float(dv);
     ew = float(dw);
   }
-  if ((eu < 0.0f || ev < 0.0f || ew < 0.0f) && (eu > 0.0f || ev > 0.0f || ew > 0.0f)) return false;
-  precise float det = eu + ev + ew;
+  e.a = a;
+  e.ks = ks;
+  e.eu = eu;
+  e.ev = ev;
+  e.ew = ew;
+  return true;
+}
+
+// The second half: the signs of the edge functions, then the distance from the triangle's plane and
+// the barycentric weights.
+LS_FN bool ray_triangle_finish(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(vec3) p1, IN(vec3) p2,
+                               IN(TriEdges) e, OUT(float) t, OUT(float) u, OUT(float) v) {
+  if ((e.eu < 0.0f || e.ev < 0.0f || e.ew < 0.0f) && (e.eu > 0.0f || e.ev > 0.0f || e.ew > 0.0f)) return false;
+  precise float det = e.eu + e.ev + e.ew;
   if (det == 0.0f) return false;
   // The plane: n from the untranslated edges, scaled by a power of two.
   precise vec3 f1 = p1 - p0;
@@ -102,16 +130,25 @@ LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(ve
   f1 = scale_pow2(f1, kf);
   f2 = scale_pow2(f2, kf);
   precise vec3 n = cross(f1, f2);
-  precise float tn = dot_in_order(n, a);
+  precise float tn = dot_in_order(n, e.a);
   precise float td = dot_in_order(n, r.dir);
   if (td == 0.0f) return false;
   // dot(n, a) / dot(n, dir) is t scaled by 2^(ks - dir_exp); a t of -0 is reported as +0.
-  precise float tt = positive_zero(scale_pow2(tn / td, r.dir_exp - ks));
+  precise float tt = positive_zero(scale_pow2(tn / td, r.dir_exp - e.ks));
   if (!(tt >= tmin && tt <= tmax)) return false;
   t = tt;
-  u = ev / det;
-  v = ew / det;
+  u = e.ev / det;
+  v = e.ew / det;
   return true;
+}
+
+// True when the triangle is hit at a distance in [tmin, tmax] (in units of the unscaled direction);
+// then t, u and v (weights of p1 and p2) are set.
+LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(vec3) p1, IN(vec3) p2,
+                        OUT(float) t, OUT(float) u, OUT(float) v) {
+  TriEdges e;
+  if (!ray_triangle_edges(r, p0, p1, p2, e)) return false;
+  return ray_triangle_finish(r, tmin, tmax, p0, p1, p2, e, t, u, v);
 }
 
 #ifdef __cplusplus

@@ -1,0 +1,49 @@
+// The wide BVH of the fast path's order-free walk: 4-wide nodes that hold only their children's boxes
+// (SoA, 128 bytes a node, like Embree's), traversed nearest child first.
+//
+// Why it may ignore the reference's visiting order: a closest-hit query's answer does not depend on
+// it (the smaller t wins, ties go to the lower (instance, triangle): common/kernels/hit.h), and the
+// box tests only prune (ray_box never prunes a box holding a hit that could still win).  So below any
+// node with no Line Space node under it, exact traversal in any order ends with the reference's hit,
+// bit for bit.  What depends on the order — a Line Space lookup's answer (it compares against the
+// current t) and the triangle an any-hit query reports — stays with the treelet walk (wide_bvh.h).
+//
+// Entries: the order-free walk starts at the *entry* nodes of a binary BVH, the topmost inner nodes
+// with no Line Space node strictly below them: the root of an exact structure, each Line Space node
+// (its subtree, when a lookup is refused), and the Line-Space-free subtrees between them.  Each entry
+// is collapsed on its own into wide nodes by opening, while fewer than 4 children, the child of
+// largest surface area.
+#pragma once
+
+#include "kernels/layouts.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace ls {
+
+struct alignas(64) ExactWideNode {
+  static constexpr int kWidth = 4;
+  float lo[3][kWidth];  // per axis, per child: its box
+  float hi[3][kWidth];
+  uint32_t child[kWidth];  // inner: wide node; leaf: its reference (leaf_ref); unused lane: LS_INVALID
+  uint32_t count[kWidth];  // leaf: primitive count; 0: inner node or unused lane
+};
+static_assert(sizeof(ExactWideNode) == 128, "two cache lines, like Embree's 4-wide node");
+
+// One collapsed BVH array (the flat BVH, all object BVHs of a 2L structure, or its top level).
+struct ExactWideTree {
+  std::vector<ExactWideNode> nodes;
+  std::vector<uint32_t> entry_of;  // per binary node: the wide node of the entry rooted there, or LS_INVALID
+  size_t entries = 0;
+  size_t bytes() const { return nodes.size() * sizeof(ExactWideNode) + entry_of.size() * sizeof(uint32_t); }
+};
+
+// Collapses the entries below each of `roots`.  node_ls may be empty (no Line Space).  leaf_ref[b]
+// is what a leaf lane of binary leaf b holds in `child` (its first triangle block, or its first
+// primitive when leaf_ref is empty).
+ExactWideTree build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
+                                    const std::vector<uint32_t>& roots, const std::vector<uint32_t>& leaf_ref);
+
+}  // namespace ls
