@@ -12,7 +12,8 @@
 // with no Line Space node strictly below them: the root of an exact structure, each Line Space node
 // (its subtree, when a lookup is refused), and the Line-Space-free subtrees between them.  Each entry
 // is collapsed on its own into wide nodes by opening, while fewer than 4 children, the child of
-// largest surface area.
+// largest surface area.  A subtree of at most kLeafMax primitives becomes one leaf: four triangles
+// cost one SIMD test whether they sit in one binary leaf or in three, and a level less is a load less.
 #pragma once
 
 #include "kernels/layouts.h"
@@ -25,25 +26,25 @@ namespace ls {
 
 struct alignas(64) ExactWideNode {
   static constexpr int kWidth = 4;
-  float lo[3][kWidth];  // per axis, per child: its box
+  float lo[3][kWidth];  // per axis, per child: its box (NaN in an unused lane)
   float hi[3][kWidth];
-  uint32_t child[kWidth];  // inner: wide node; leaf: its reference (leaf_ref); unused lane: LS_INVALID
+  uint32_t child[kWidth];  // inner: wide node; leaf: its first primitive (triangle trees: its first
+                           // block lane, see triangle_blocks.h); unused lane: LS_INVALID
   uint32_t count[kWidth];  // leaf: primitive count; 0: inner node or unused lane
 };
 static_assert(sizeof(ExactWideNode) == 128, "two cache lines, like Embree's 4-wide node");
 
 // One collapsed BVH array (the flat BVH, all object BVHs of a 2L structure, or its top level).
 struct ExactWideTree {
+  static constexpr uint32_t kLeafMax = 4;
   std::vector<ExactWideNode> nodes;
   std::vector<uint32_t> entry_of;  // per binary node: the wide node of the entry rooted there, or LS_INVALID
   size_t entries = 0;
   size_t bytes() const { return nodes.size() * sizeof(ExactWideNode) + entry_of.size() * sizeof(uint32_t); }
 };
 
-// Collapses the entries below each of `roots`.  node_ls may be empty (no Line Space).  leaf_ref[b]
-// is what a leaf lane of binary leaf b holds in `child` (its first triangle block, or its first
-// primitive when leaf_ref is empty).
+// Collapses the entries below each of `roots`.  node_ls may be empty (no Line Space).
 ExactWideTree build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                                    const std::vector<uint32_t>& roots, const std::vector<uint32_t>& leaf_ref);
+                                    const std::vector<uint32_t>& roots);
 
 }  // namespace ls

@@ -7,6 +7,7 @@
 #include "wide_bvh.h"
 
 #include <bit>
+#include <cstddef>
 
 namespace ls {
 
@@ -139,7 +140,7 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
     const uint lane = pos - 2;
     const bool leaf = !root && node.count[lane] > 0;
     const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u,
-                          leaf ? node.block[lane] : LS_INVALID, root ? node.root_exact : node.exact[lane]);
+                          leaf ? node.tri_lane[lane] : LS_INVALID, root ? node.root_exact : node.exact[lane]);
     if (v == Visit::Stop) return true;
     if (v == Visit::Descend && !leaf) {
       if (root) {
@@ -149,7 +150,7 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
           const uint l = p - 2u;
           if (!(tnear[depth][l] <= tfar[depth][l])) continue;
           const char* next = node.count[l] == 0u ? reinterpret_cast<const char*>(&tree.nodes[node.first[l]])
-                                                 : prefetch_leaf(node.block[l]);
+                                                 : prefetch_leaf(node.tri_lane[l]);
           const size_t bytes = node.count[l] == 0u ? sizeof(Node) : sizeof(TriBlock);
           if (next)
             for (size_t line = 0; line < bytes; line += 64) __builtin_prefetch(next + line);
@@ -205,37 +206,63 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
   }
 }
 
+// The per-ray constants of the exact wide nodes' box tests, broadcast once: for each axis the
+// origin, the reciprocal direction and where in a node the slab's entry and exit planes are.
+struct ExactBoxRay {
+  Float4 origin[3];
+  Float4 inv_dir[3];
+  uint32_t enter[3];  // byte offset in ExactWideNode of the entry plane's row (lo or hi)
+  uint32_t leave[3];
+  bool parallel[3];  // safe_reciprocal's huge value: the ray runs parallel to that slab
+  bool any_parallel;
+};
+
+ExactBoxRay make_exact_box_ray(const BoxRay& r) {
+  ExactBoxRay e;
+  for (int a = 0; a < 3; ++a) {
+    e.origin[a] = Float4(r.origin[a]);
+    e.inv_dir[a] = Float4(r.inv_dir[a]);
+    const uint32_t lo = uint32_t(offsetof(ExactWideNode, lo) + sizeof(float[4]) * size_t(a));
+    const uint32_t hi = uint32_t(offsetof(ExactWideNode, hi) + sizeof(float[4]) * size_t(a));
+    e.enter[a] = r.near_is_lo[a] ? lo : hi;
+    e.leave[a] = r.near_is_lo[a] ? hi : lo;
+    e.parallel[a] = r.parallel[a];
+  }
+  e.any_parallel = r.any_parallel;
+  return e;
+}
+
 // ray_box on the four children of an exact wide node against [tmin, tmax]: the lanes hit (bit l) and
 // their entry distances.  The scalar kernel's arithmetic, except that each slab's entry and exit are
 // taken from the plane the ray's direction says instead of as min and max of the two: for a finite
 // ray the same values (rounding is monotone), up to the sign of a zero, which no comparison sees.
-LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode& node, const BoxRay& r, float tmin, float tmax, float* tnear) {
+// An unused lane's box is NaN, which no ray enters: its entry distance is NaN on an axis the ray
+// crosses (glm_max keeps a NaN first operand) and +big on one it runs along.
+LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode& node, const ExactBoxRay& r, const Float4& tmin, float tmax,
+                                          float* tnear) {
   constexpr float big = 3.0e38f;
-  constexpr float slack = lsk::LS_WIDEN_SLACK;
+  const char* base = reinterpret_cast<const char*>(&node);
   Float4 tn[3];
   Float4 tf[3];
   for (int a = 0; a < 3; ++a) {
-    const Float4 o(r.origin[a]);
     if (r.any_parallel && r.parallel[a]) {
       const Float4 lo = Float4::load_aligned(node.lo[a]);
       const Float4 hi = Float4::load_aligned(node.hi[a]);
-      const auto inside = (o >= lo) && (o <= hi);
+      const auto inside = (r.origin[a] >= lo) && (r.origin[a] <= hi);
       tn[a] = xsimd::select(inside, Float4(-big), Float4(big));
       tf[a] = xsimd::select(inside, Float4(big), Float4(-big));
     } else {
-      const Float4 inv(r.inv_dir[a]);
-      const Float4 enter = Float4::load_aligned(r.near_is_lo[a] ? node.lo[a] : node.hi[a]);
-      const Float4 leave = Float4::load_aligned(r.near_is_lo[a] ? node.hi[a] : node.lo[a]);
-      tn[a] = (enter - o) * inv;
-      tf[a] = (leave - o) * inv;
+      const Float4 enter = Float4::load_aligned(reinterpret_cast<const float*>(base + r.enter[a]));
+      const Float4 leave = Float4::load_aligned(reinterpret_cast<const float*>(base + r.leave[a]));
+      tn[a] = (enter - r.origin[a]) * r.inv_dir[a];
+      tf[a] = (leave - r.origin[a]) * r.inv_dir[a];
     }
   }
-  const Float4 near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], Float4(tmin)));
+  const Float4 near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], tmin));
   const Float4 far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], Float4(tmax)));
-  const Float4 widened = far + xsimd::abs(far) * Float4(slack);
+  const Float4 widened = far + xsimd::abs(far) * Float4(lsk::LS_WIDEN_SLACK);
   near.store_aligned(tnear);
-  const auto used = Int4::load_aligned(reinterpret_cast<const int32_t*>(node.child)) != Int4(-1);
-  return lane_bits(near <= widened) & lane_bits(used);
+  return lane_bits(near <= widened);
 }
 
 // The order-free closest-hit walk below an exact wide node (whose binary node's box the caller has
@@ -274,10 +301,11 @@ struct ExactWalk {
   }
 
   // Visits the next wide node or leaf; leaf(child, count) tests a leaf's primitives against the
-  // running hit.  Every child the boxes admit starts loading at once.  False when the walk is over.
+  // running hit.  When the boxes admit several children, all of them start loading at once.  False
+  // when the walk is over.
   template <class LeafFn, class PrefetchFn>
-  LS_ALWAYS_INLINE bool step(const ExactWideTree& tree, const BoxRay& ray, float tmin, const Hit& hit, LeafFn&& leaf,
-            PrefetchFn&& prefetch_leaf) {
+  LS_ALWAYS_INLINE bool step(const ExactWideTree& tree, const ExactBoxRay& ray, const Float4& tmin, const Hit& hit,
+                             LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
     if (count != 0u) {
       leaf(child, count);
       return pop(hit.t);
@@ -285,8 +313,16 @@ struct ExactWalk {
     const ExactWideNode& node = tree.nodes[child];
     alignas(16) float tn[4];
     unsigned lanes = exact_box_tests(node, ray, tmin, hit.t, tn);
-    for (unsigned m = lanes; m != 0u; m &= m - 1u) {
-      const unsigned l = unsigned(std::countr_zero(m));
+    if (lanes == 0u) return pop(hit.t);
+    unsigned near = unsigned(std::countr_zero(lanes));
+    lanes &= lanes - 1u;
+    if (lanes == 0u) {  // one child: go on with it
+      child = node.child[near];
+      count = node.count[near];
+      return true;
+    }
+    auto push = [&](unsigned l) {
+      stack[sp++] = Pending{node.child[l], node.count[l], tn[l]};
       if (node.count[l] == 0u) {
         const char* p = reinterpret_cast<const char*>(&tree.nodes[node.child[l]]);
         __builtin_prefetch(p);
@@ -294,29 +330,29 @@ struct ExactWalk {
       } else {
         prefetch_leaf(node.child[l]);
       }
-    }
-    if (lanes == 0u) return pop(hit.t);
-    const unsigned first = unsigned(std::countr_zero(lanes));
+    };
+    unsigned other = unsigned(std::countr_zero(lanes));
     lanes &= lanes - 1u;
-    if (lanes == 0u) {  // one child: go on with it
-      child = node.child[first];
-      count = node.count[first];
-      return true;
-    }
-    // Several: push them farthest first (insertion into the top of the stack), go on with the nearest.
-    const int base = sp;
-    for (unsigned l = first;; l = unsigned(std::countr_zero(lanes)), lanes &= lanes - 1u) {
-      int j = sp++;
-      while (j > base && stack[j - 1].t < tn[l]) {
-        stack[j] = stack[j - 1];
-        --j;
+    if (tn[other] < tn[near]) std::swap(near, other);
+    if (lanes == 0u) {  // two: push the farther, go on with the nearer
+      push(other);
+    } else {  // three or four: push them farthest first, go on with the nearest
+      unsigned order[4] = {near, other, 0u, 0u};
+      unsigned n = 2;
+      for (; lanes != 0u; lanes &= lanes - 1u) {
+        unsigned l = unsigned(std::countr_zero(lanes));
+        unsigned j = n++;
+        while (j > 0u && tn[order[j - 1u]] > tn[l]) {
+          order[j] = order[j - 1u];
+          --j;
+        }
+        order[j] = l;
       }
-      stack[j] = Pending{node.child[l], node.count[l], tn[l]};
-      if (lanes == 0u) break;
+      for (unsigned k = n - 1u; k > 0u; --k) push(order[k]);
+      near = order[0];
     }
-    --sp;
-    child = stack[sp].child;
-    count = stack[sp].count;
+    child = node.child[near];
+    count = node.count[near];
     return true;
   }
 };
@@ -326,9 +362,11 @@ template <class LeafFn, class PrefetchFn>
 inline void walk_exact(const ExactWideTree& tree, uint entry, const BoxRay& ray, float tmin, const Hit& hit, LeafFn&& leaf,
                        PrefetchFn&& prefetch_leaf) {
   if (hit.t != hit.t) return;  // a NaN tmax: no t is <= it, the reference finds nothing either
+  const ExactBoxRay box_ray = make_exact_box_ray(ray);
+  const Float4 tmin4(tmin);
   ExactWalk walk;
   walk.start(entry);
-  while (walk.step(tree, ray, tmin, hit, leaf, prefetch_leaf)) {
+  while (walk.step(tree, box_ray, tmin4, hit, leaf, prefetch_leaf)) {
   }
 }
 
@@ -349,10 +387,10 @@ class WideTracer final : public FastTracer {
     const std::vector<uint32_t> none;
     const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
     auto part = std::make_shared<ObjectPart<K>>();
-    part->blocks = build_triangle_blocks(accel.nodes, accel.tris);
     const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
-    part->exact = build_exact_wide_tree(accel.nodes, node_ls, roots, part->blocks.block_of);
-    part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.block_of, part->exact.entry_of);
+    part->exact = build_exact_wide_tree(accel.nodes, node_ls, roots);
+    part->blocks = build_triangle_blocks(accel.nodes, accel.tris, part->exact);
+    part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.lane_of, part->exact.entry_of);
     if (two_level_) build_top(accel);
     part_ = std::move(part);
     blocks_ = part_->blocks.blocks.data();
@@ -386,7 +424,7 @@ class WideTracer final : public FastTracer {
   // The top level: treelets (ordered: Line Space structures and any hit) and the exact wide tree,
   // whose leaf lanes hold their first instance.
   void build_top(const Accel& accel) {
-    top_exact_ = build_exact_wide_tree(accel.top_nodes, {}, {0u}, {});
+    top_exact_ = build_exact_wide_tree(accel.top_nodes, {}, {0u});
     top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
   }
 
@@ -396,36 +434,42 @@ class WideTracer final : public FastTracer {
                  bool any_hit, bool use_ls, Hit& hit, uint& hit_prim) const {
     const lsk::TriRay tri_ray = lsk::make_tri_ray(origin, dir);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
-    float t_root;
-    if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
     const BoxRay box_ray = make_box_ray(origin, inv_dir);
     const bool order_free = !any_hit && order_free_ray(origin, dir, tmin);
-    auto visit = [&](uint ls, bool leaf, uint, uint count, uint block, uint entry) {
+    auto exact = [&](uint entry) {
+      walk_exact(
+          part_->exact, entry, box_ray, tmin, hit,
+          [&](uint lane, uint n) { trace_blocks(c, blocks_, lane, n, tri_ray, tmin, instance, false, hit, hit_prim); },
+          [&](uint lane) { prefetch_block(lane / 4u); });
+    };
+    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
+    const uint root_entry = part_->exact.entry_of[root];
+    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID) {
+      // The entry's wide node tests the root's children, which pass only where the root's box would.
+      exact(root_entry);
+      return false;
+    }
+    float t_root;
+    if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
+    auto visit = [&](uint ls, bool leaf, uint, uint count, uint tri_lane, uint entry) {
       if (use_ls && ls != LS_INVALID) {
         const uint answer = c.ls_lookup(ls, origin, dir, inv_dir, tmin, instance, hit, hit_prim);
         if (answer == lsk::TraceContext::LS_ACCEPTED && any_hit) return Visit::Stop;
         if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
       }
       if (leaf)
-        return trace_blocks(c, blocks_, block, count, tri_ray, tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
-                                                                                                      : Visit::Skip;
+        return trace_blocks(c, blocks_, tri_lane, count, tri_ray, tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
+                                                                                                        : Visit::Skip;
       if (!order_free || entry == LS_INVALID) return Visit::Descend;
-      walk_exact(
-          part_->exact, entry, box_ray, tmin, hit,
-          [&](uint first_block, uint n) {
-            trace_blocks(c, blocks_, first_block, n, tri_ray, tmin, instance, false, hit, hit_prim);
-          },
-          [&](uint first_block) { prefetch_block(first_block); });
+      exact(entry);
       return Visit::Skip;
     };
-    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
     const lsk::BvhNode& node = c.nodes[root];
     if (node.count > 0)  // a root that is a leaf has no wide node
-      return visit(root_ls, true, node.first, node.count, part_->blocks.block_of[root], LS_INVALID) == Visit::Stop;
-    const uint entry = part_->exact.entry_of[root];
-    if (order_free && entry != LS_INVALID)  // the whole tree below the root is order-free
-      return visit(root_ls, false, 0u, 0u, LS_INVALID, entry) == Visit::Stop;
-    auto leaf_block = [&](uint block) { return reinterpret_cast<const char*>(&blocks_[block]); };
+      return visit(root_ls, true, node.first, node.count, part_->blocks.lane_of[root], LS_INVALID) == Visit::Stop;
+    if (order_free && root_entry != LS_INVALID)  // a Line Space at the root, then the whole tree order-free
+      return visit(root_ls, false, 0u, 0u, LS_INVALID, root_entry) == Visit::Stop;
+    auto leaf_block = [&](uint lane) { return reinterpret_cast<const char*>(&blocks_[lane / 4u]); };
     return walk(part_->tree, part_->tree.wide_of[root], box_ray, tmin, hit, visit, leaf_block);
   }
 

@@ -1,33 +1,59 @@
 #include "triangle_blocks.h"
 
+#include "exact_wide_bvh.h"
 #include "huge_pages.h"
 #include "parallel.h"
 
 namespace ls {
 
-TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, const std::vector<lsk::Triangle>& tris) {
-  TriangleBlocks out;
-  out.block_of.assign(nodes.size(), lsk::LS_INVALID);
-  size_t total = 0;  // offsets first, then the blocks filled in parallel
-  for (size_t n = 0; n < nodes.size(); ++n)
-    if (nodes[n].count > 0) {
-      out.block_of[n] = uint32_t(total);
-      total += (nodes[n].count + 3u) / 4u;
-    }
-  resize_huge(out.blocks, total);  // zeros: vertices past a leaf's count stay 0
-  ls::parallel_for(size_t(0), nodes.size(), [&](size_t n) {
-    const lsk::BvhNode& node = nodes[n];
-    for (uint32_t k = 0; k < (node.count + 3u) / 4u * 4u; ++k) {
-      TriBlock& block = out.blocks[out.block_of[n] + k / 4u];
-      if (k >= node.count) {
-        block.prim[k % 4u] = lsk::LS_INVALID;
-        continue;
+TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, const std::vector<lsk::Triangle>& tris,
+                                     ExactWideTree& exact) {
+  struct Range {
+    uint32_t first;
+    uint32_t count;
+  };
+  std::vector<Range> ranges;  // each gets blocks of its own, lanes past its end unused
+  std::vector<uint32_t*> exact_children;
+  for (ExactWideNode& node : exact.nodes)
+    for (int l = 0; l < ExactWideNode::kWidth; ++l)
+      if (node.count[l] > 0) {
+        ranges.push_back(Range{node.child[l], node.count[l]});
+        exact_children.push_back(&node.child[l]);
       }
-      const lsk::Triangle& t = tris[node.first + k];
-      const glm::vec4* v[3] = {&t.v0, &t.v1, &t.v2};
-      for (int i = 0; i < 3; ++i)
-        for (int a = 0; a < 3; ++a) block.v[i][a][k % 4u] = (*v[i])[a];
-      block.prim[k % 4u] = node.first + k;
+  // The lane of every triangle inside an exact leaf, then the binary leaves outside them.
+  std::vector<uint32_t> lane_of_tri(tris.size(), lsk::LS_INVALID);
+  size_t lanes = 0;
+  for (size_t r = 0; r < ranges.size(); ++r) {
+    *exact_children[r] = uint32_t(lanes);
+    for (uint32_t k = 0; k < ranges[r].count; ++k) lane_of_tri[ranges[r].first + k] = uint32_t(lanes + k);
+    lanes += (ranges[r].count + 3u) / 4u * 4u;
+  }
+  TriangleBlocks out;
+  out.lane_of.assign(nodes.size(), lsk::LS_INVALID);
+  for (size_t n = 0; n < nodes.size(); ++n) {
+    if (nodes[n].count == 0) continue;
+    if (lane_of_tri[nodes[n].first] == lsk::LS_INVALID) {
+      ranges.push_back(Range{nodes[n].first, nodes[n].count});
+      for (uint32_t k = 0; k < nodes[n].count; ++k) lane_of_tri[nodes[n].first + k] = uint32_t(lanes + k);
+      lanes += (nodes[n].count + 3u) / 4u * 4u;
+    }
+    out.lane_of[n] = lane_of_tri[nodes[n].first];
+  }
+  resize_huge(out.blocks, lanes / 4u);  // zeros: vertices of unused lanes stay 0
+  ls::parallel_for(size_t(0), out.blocks.size(), [&](size_t b) {
+    for (uint32_t l = 0; l < 4u; ++l) out.blocks[b].prim[l] = lsk::LS_INVALID;
+  });
+  ls::parallel_for(size_t(0), ranges.size(), [&](size_t r) {
+    for (uint32_t k = 0; k < ranges[r].count; ++k) {
+      const uint32_t i = ranges[r].first + k;
+      const uint32_t lane = lane_of_tri[i];
+      TriBlock& block = out.blocks[lane / 4u];
+      const glm::vec4* v[3] = {&tris[i].v0, &tris[i].v1, &tris[i].v2};
+      for (int p = 0; p < 3; ++p)
+        for (int a = 0; a < 3; ++a) block.v[p][a][lane % 4u] = (*v[p])[a];
+      const lsk::vec3 n = lsk::triangle_plane_normal(lsk::vec3(tris[i].v0), lsk::vec3(tris[i].v1), lsk::vec3(tris[i].v2));
+      for (int a = 0; a < 3; ++a) block.n[a][lane % 4u] = n[a];
+      block.prim[lane % 4u] = i;
     }
   });
   return out;

@@ -5,8 +5,9 @@
 // with its flush-to-zero rule, shear, edge functions — with the same operations lane by lane, hence
 // the same values.  A lane whose edge signs reject the triangle is dropped; a lane with a zero edge
 // function (the kernel recomputes those in double) goes through the whole scalar kernel; every other
-// lane is finished by the kernel's own second half (ray_triangle_finish) on the lane's values.  So a
-// hit's t, u and v are the kernel's bit for bit, and lanes are offered in the leaf's order.
+// lane is finished by the kernel's own second half (ray_triangle_plane) on the lane's values and the
+// triangle's plane normal, which the block keeps (triangle_plane_normal, computed once).  So a hit's
+// t, u and v are the kernel's bit for bit, and lanes are offered in the leaf's order.
 #pragma once
 
 #include "simd.h"
@@ -18,37 +19,40 @@
 
 namespace ls {
 
-// Four triangles of a leaf: v[vertex][axis][lane], and each lane's index into tris[] (LS_INVALID
-// past the leaf's end, where the vertices are 0).
+// Four triangles of a leaf: v[vertex][axis][lane], the plane normals n[axis][lane] and each lane's
+// index into tris[] (LS_INVALID past the leaf's end, where the vertices are 0).  A *lane index* is
+// block * 4 + lane.
 struct alignas(16) TriBlock {
   float v[3][3][4];
+  float n[3][4];
   uint32_t prim[4];
 };
 
-// The blocks of every leaf of one BVH array, in leaf order; a leaf of n triangles has (n + 3) / 4
-// consecutive blocks starting at block_of[leaf].
+// The triangles of one BVH array in blocks: each leaf of its exact wide tree gets blocks of its own
+// (its child becomes the leaf's first lane index), and so does every binary leaf outside them (the
+// treelets' leaves above the entries).  A binary leaf inside an exact leaf is a run of that leaf's
+// lanes: its triangles stay in the builder's order either way.
 struct TriangleBlocks {
   std::vector<TriBlock> blocks;
-  std::vector<uint32_t> block_of;  // per BVH node: its first block (leaves), LS_INVALID (inner nodes)
-  size_t bytes() const { return blocks.size() * sizeof(TriBlock) + block_of.size() * sizeof(uint32_t); }
+  std::vector<uint32_t> lane_of;  // per binary node: a leaf's first lane index; LS_INVALID for inner nodes
+  size_t bytes() const { return blocks.size() * sizeof(TriBlock) + lane_of.size() * sizeof(uint32_t); }
 };
 
-TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, const std::vector<lsk::Triangle>& tris);
+struct ExactWideTree;
+TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, const std::vector<lsk::Triangle>& tris,
+                                     ExactWideTree& exact);
 
 namespace block_lanes {
 
-// lsk::scale_pow2(x, e) lane by lane for e in [-126, 126] (what unit_exponent returns): x * 2^e is
-// exact unless the result would be denormal, where the kernel flushes to a signed zero instead; a
-// zero, an infinity or a NaN stays itself.  The kernel's two half-steps give the same exact product.
-LS_ALWAYS_INLINE Float4 scale_pow2(const Float4& x, const Int4& e, const Float4& pow2_e) {
-  const Int4 field = (xsimd::bitwise_cast<Int4>(x) >> 23) & Int4(255);
-  const auto flush = ((field - Int4(127) + e) < Int4(-126)) && (field != Int4(255));
-  const Int4 bits = xsimd::select(flush, xsimd::bitwise_cast<Int4>(x * Float4(0.0f)), xsimd::bitwise_cast<Int4>(x * pow2_e));
-  return xsimd::bitwise_cast<Float4>(bits);
-}
-
-LS_ALWAYS_INLINE Float4 max_abs(const Float4& x, const Float4& y, const Float4& z) {
-  return glm_max(glm_max(xsimd::abs(x), xsimd::abs(y)), xsimd::abs(z));
+// lsk::scale_pow2(x, e) lane by lane for e in [-126, 126] (what unit_exponent returns): x * 2^e,
+// exact, unless the result would be denormal, where the kernel flushes to a signed zero instead
+// (biased exponent field < 1 - e; an infinity or a NaN, field 255, never is).  The kernel's two
+// half-steps give the same exact product.  A zero gives a zero of its sign either way.
+LS_ALWAYS_INLINE Float4 scale_pow2(const Float4& x, const Int4& one_minus_e, const Float4& pow2_e) {
+  const Int4 bits = xsimd::bitwise_cast<Int4>(x);
+  const Int4 field = (bits >> 23) & Int4(255);
+  const Int4 scaled = xsimd::bitwise_cast<Int4>(x * pow2_e);
+  return xsimd::bitwise_cast<Float4>(xsimd::select(field < one_minus_e, bits & Int4(int32_t(0x80000000u)), scaled));
 }
 
 }  // namespace block_lanes
@@ -58,7 +62,7 @@ LS_ALWAYS_INLINE Float4 max_abs(const Float4& x, const Float4& y, const Float4& 
 // with the lane's edges).  Lanes whose vertices all sit on the origin are in neither (the kernel
 // rejects them before computing edges: their edges are 0, so they land in `full`, which rejects).
 struct BlockEdges {
-  alignas(16) float a[3][4];  // per axis, per lane: p0 - origin scaled by 2^ks
+  alignas(16) float a[3][4];  // per sheared axis (kx, ky, kz), per lane: p0 - origin scaled by 2^ks
   alignas(16) int32_t ks[4];
   alignas(16) float eu[4];
   alignas(16) float ev[4];
@@ -67,32 +71,46 @@ struct BlockEdges {
   unsigned finish = 0;
 };
 
+// The vertices are read in the ray's axis order (kx, ky, kz) straight from the block, so no axis is
+// picked from registers at run time.  The maximum over the nine coordinates does not depend on that
+// order (max is exact); only a NaN could make it, and a NaN coordinate rejects the lane whatever
+// the scale (its edge functions and t are NaN), as it does in the kernel.
 LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, BlockEdges& out) {
   using namespace block_lanes;
-  Float4 d[3][3];  // translated vertices: d[vertex][axis]
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) d[k][a] = Float4::load_aligned(block.v[k][a]) - Float4(r.origin[a]);
-  const Float4 m = glm_max(glm_max(max_abs(d[0][0], d[0][1], d[0][2]), max_abs(d[1][0], d[1][1], d[1][2])),
-                           max_abs(d[2][0], d[2][1], d[2][2]));
+  const uint32_t axis[3] = {r.kx, r.ky, r.kz};
+  Float4 d[3][3];  // translated vertices: d[vertex][sheared axis]
+  Float4 abs_d[3][3];
+  for (int a = 0; a < 3; ++a) {
+    const Float4 o(r.origin[axis[a]]);
+    for (int k = 0; k < 3; ++k) {
+      d[k][a] = Float4::load_aligned(block.v[k][axis[a]]) - o;
+      abs_d[k][a] = xsimd::abs(d[k][a]);
+    }
+  }
+  const Float4 m = glm_max(glm_max(glm_max(glm_max(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),
+                                   glm_max(glm_max(abs_d[1][0], abs_d[1][1]), abs_d[1][2])),
+                           glm_max(glm_max(abs_d[2][0], abs_d[2][1]), abs_d[2][2]));
   // unit_exponent(m) = clamp(-float_exponent(m), -126, 126); lanes with m == 0 end as zero edges.
   const Int4 neg_exp = Int4(127) - ((xsimd::bitwise_cast<Int4>(m) >> 23) & Int4(255));
   const Int4 ks = xsimd::select(neg_exp > Int4(126), Int4(126), xsimd::select(neg_exp < Int4(-126), Int4(-126), neg_exp));
   const Float4 pow2_ks = xsimd::bitwise_cast<Float4>((ks + Int4(127)) << 23);
+  // A flush to zero needs a coordinate below 2^(-126 - ks); where none is, the product alone is exact.
+  const Int4 one_minus_ks = Int4(1) - ks;
+  const Float4 smallest = glm_min(glm_min(glm_min(glm_min(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),
+                                          glm_min(glm_min(abs_d[1][0], abs_d[1][1]), abs_d[1][2])),
+                                  glm_min(glm_min(abs_d[2][0], abs_d[2][1]), abs_d[2][2]));
+  const bool may_flush = lane_bits(((xsimd::bitwise_cast<Int4>(smallest) >> 23) < one_minus_ks)) != 0u;
+  Float4 p[3][3];
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) p[k][a] = may_flush ? scale_pow2(d[k][a], one_minus_ks, pow2_ks) : d[k][a] * pow2_ks;
+  for (int a = 0; a < 3; ++a) p[0][a].store_aligned(out.a[a]);
   Float4 sx[3];
   Float4 sy[3];
   const Float4 shear_x(r.sx);
   const Float4 shear_y(r.sy);
   for (int k = 0; k < 3; ++k) {
-    const Float4 px = scale_pow2(d[k][r.kx], ks, pow2_ks);
-    const Float4 py = scale_pow2(d[k][r.ky], ks, pow2_ks);
-    const Float4 pz = scale_pow2(d[k][r.kz], ks, pow2_ks);
-    if (k == 0) {
-      px.store_aligned(out.a[r.kx]);
-      py.store_aligned(out.a[r.ky]);
-      pz.store_aligned(out.a[r.kz]);
-    }
-    sx[k] = px - shear_x * pz;
-    sy[k] = py - shear_y * pz;
+    sx[k] = p[k][0] - shear_x * p[k][2];
+    sy[k] = p[k][1] - shear_y * p[k][2];
   }
   const Float4 eu = sx[2] * sy[1] - sy[2] * sx[1];
   const Float4 ev = sx[0] * sy[2] - sy[0] * sx[2];
@@ -110,39 +128,42 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, B
   }
 }
 
-// lsk::TraceContext::trace_leaf over a leaf's blocks: the leaf's `count` triangles from block
-// `first_block` on, tested and offered in the leaf's order.  Returns true when any_hit is set and a
-// hit was found (the caller stops).  Flattened: the kernel's halves are inlined into it.
-[[gnu::flatten]] inline bool trace_blocks(const lsk::TraceContext& c, const TriBlock* blocks, uint32_t first_block, uint32_t count,
-                         const lsk::TriRay& tri_ray, float tmin, uint32_t instance, bool any_hit, lsk::Hit& hit,
-                         uint32_t& hit_prim) {
+// lsk::TraceContext::trace_leaf over blocks: the `count` triangles from lane index `lane` on, tested
+// and offered in that order.  Returns true when any_hit is set and a hit was found (the caller
+// stops).  Flattened: the kernel's halves are inlined into it.
+[[gnu::flatten]] inline bool trace_blocks(const lsk::TraceContext& c, const TriBlock* blocks, uint32_t lane, uint32_t count,
+                                          const lsk::TriRay& tri_ray, float tmin, uint32_t instance, bool any_hit,
+                                          lsk::Hit& hit, uint32_t& hit_prim) {
   BlockEdges e;
-  for (uint32_t b = 0; b < count; b += 4u) {
-    const TriBlock& blk = blocks[first_block + b / 4u];
+  for (uint32_t at = lane, end = lane + count; at < end; at = (at | 3u) + 1u) {
+    const TriBlock& blk = blocks[at / 4u];
     block_edges(blk, tri_ray, e);
-    unsigned lanes = e.full | e.finish;
-    if (count - b < 4u) lanes &= (1u << (count - b)) - 1u;
+    unsigned lanes = (e.full | e.finish) & (15u << (at % 4u));
+    if (end - (at & ~3u) < 4u) lanes &= (1u << (end - (at & ~3u))) - 1u;
     while (lanes != 0u) {
       const unsigned l = unsigned(std::countr_zero(lanes));
       lanes &= lanes - 1u;
-      const lsk::vec3 p0(blk.v[0][0][l], blk.v[0][1][l], blk.v[0][2][l]);
-      const lsk::vec3 p1(blk.v[1][0][l], blk.v[1][1][l], blk.v[1][2][l]);
-      const lsk::vec3 p2(blk.v[2][0][l], blk.v[2][1][l], blk.v[2][2][l]);
       float t;
       float u;
       float v;
       bool hits;
       if (e.full >> l & 1u) {
+        const lsk::vec3 p0(blk.v[0][0][l], blk.v[0][1][l], blk.v[0][2][l]);
+        const lsk::vec3 p1(blk.v[1][0][l], blk.v[1][1][l], blk.v[1][2][l]);
+        const lsk::vec3 p2(blk.v[2][0][l], blk.v[2][1][l], blk.v[2][2][l]);
         hits = lsk::ray_triangle(tri_ray, tmin, hit.t, p0, p1, p2, t, u, v);
       } else {
         lsk::TriEdges edges;
-        edges.a = lsk::vec3(e.a[0][l], e.a[1][l], e.a[2][l]);
+        edges.a[tri_ray.kx] = e.a[0][l];
+        edges.a[tri_ray.ky] = e.a[1][l];
+        edges.a[tri_ray.kz] = e.a[2][l];
         edges.ks = e.ks[l];
         edges.eu = e.eu[l];
         edges.ev = e.ev[l];
         edges.ew = e.ew[l];
         edges.pad = 0.0f;
-        hits = lsk::ray_triangle_finish(tri_ray, tmin, hit.t, p0, p1, p2, edges, t, u, v);
+        const lsk::vec3 n(blk.n[0][l], blk.n[1][l], blk.n[2][l]);
+        hits = lsk::ray_triangle_plane(tri_ray, tmin, hit.t, n, edges, t, u, v);
       }
       if (!hits) continue;
       const uint32_t i = blk.prim[l];

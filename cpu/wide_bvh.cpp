@@ -12,7 +12,7 @@ template <int K>
 struct Collapser {
   const std::vector<lsk::BvhNode>& nodes;
   const std::vector<uint32_t>& node_ls;
-  const std::vector<uint32_t>& block_of;
+  const std::vector<uint32_t>& lane_of;
   const std::vector<uint32_t>& entry_of;
   WideTree<K>& tree;
 
@@ -71,7 +71,7 @@ struct Collapser {
       w.count[lane] = n.count;
       w.first[lane] = n.count > 0 ? n.first : 0u;
       w.ls[lane] = ls_of(c);
-      w.block[lane] = n.count > 0 ? of(block_of, c) : lsk::LS_INVALID;
+      w.tri_lane[lane] = n.count > 0 ? of(lane_of, c) : lsk::LS_INVALID;
       w.exact[lane] = n.count > 0 ? lsk::LS_INVALID : of(entry_of, c);
     }
     tree.nodes.push_back(w);
@@ -88,11 +88,11 @@ struct Collapser {
 
 template <int K>
 WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                            const std::vector<uint32_t>& roots, const std::vector<uint32_t>& block_of,
+                            const std::vector<uint32_t>& roots, const std::vector<uint32_t>& lane_of,
                             const std::vector<uint32_t>& entry_of) {
   WideTree<K> tree;
   tree.wide_of.assign(nodes.size(), lsk::LS_INVALID);
-  Collapser<K> c{nodes, node_ls, block_of, entry_of, tree};
+  Collapser<K> c{nodes, node_ls, lane_of, entry_of, tree};
   auto collapsible = [&](uint32_t r) { return r != lsk::LS_INVALID && r < nodes.size() && nodes[r].count == 0; };
   size_t total = 0;
   for (uint32_t r : roots)

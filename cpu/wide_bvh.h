@@ -37,7 +37,7 @@ struct alignas(64) WideNode {
   uint32_t first[kLanes];   // leaf: first triangle / instance; bottom-level inner node: its wide node
   uint32_t count[kLanes];   // leaf: primitive count; 0: inner node (or an unused lane)
   uint32_t ls[kLanes];      // the node's LsNode, or LS_INVALID
-  uint32_t block[kLanes];   // triangle leaf: its first 4-triangle block (triangle_blocks.h)
+  uint32_t tri_lane[kLanes];  // triangle leaf: the lane index of its first triangle (triangle_blocks.h)
   uint32_t exact[kLanes];   // inner node: the order-free walk's entry rooted there (exact_wide_bvh.h)
   uint32_t root_ls;         // the treelet root's LsNode, or LS_INVALID
   uint32_t root_exact;      // the treelet root's entry, or LS_INVALID
@@ -52,10 +52,10 @@ struct WideTree {
 };
 
 // Collapses `nodes` below each of `roots`.  Per binary node, each of these may be empty (none): node_ls
-// (its LsNode), block_of (a leaf's first triangle block), entry_of (the exact wide tree's entry).
+// (its LsNode), lane_of (a leaf's first triangle lane), entry_of (the exact wide tree's entry).
 template <int K>
 WideTree<K> build_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                            const std::vector<uint32_t>& roots, const std::vector<uint32_t>& block_of,
+                            const std::vector<uint32_t>& roots, const std::vector<uint32_t>& lane_of,
                             const std::vector<uint32_t>& entry_of);
 
 }  // namespace ls

@@ -25,9 +25,15 @@ LS_FN int unit_exponent(float m) {
 LS_FN float pow2(int e) { return intBitsToFloat((e + 127) << 23); }
 
 // x * 2^e, saturating to +-inf above the float range and flushing to 0 below it (GLSL leaves ldexp
-// undefined there); exact otherwise.  Two multiplications by halves of e keep each factor in range,
-// and since both move x the same way the intermediate stays between x and the result.
+// undefined there); exact otherwise.  A normal x with a normal result only changes its exponent
+// field, which is set directly (what the multiplication gives, without the two multiplications).
+// Otherwise: two multiplications by halves of e keep each factor in range, and since both move x
+// the same way the intermediate stays between x and the result.
 LS_FN float scale_pow2(float x, int e) {
+  int bits = floatBitsToInt(x);
+  int field = (bits >> 23) & 255;
+  if (field != 0 && field != 255 && field + e >= 1 && field + e <= 254)
+    return intBitsToFloat((bits & int(0x807FFFFFu)) | ((field + e) << 23));
   if (x == 0.0f || isinf(x) || isnan(x)) return x;
   int ex = float_exponent(x);
   if (ex + e > 127) return x < 0.0f ? -ls_infinity() : ls_infinity();

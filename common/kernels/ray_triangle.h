@@ -64,7 +64,7 @@ LS_FN TriRay make_tri_ray(IN(vec3) origin, IN(vec3) dir) {
 
 // The first half of the test: the triangle translated to the ray's origin, scaled and sheared, and
 // its three edge functions.  The CPU's fast path computes the same values four triangles at a time
-// and finishes the survivors with ray_triangle_finish (cpu/triangle_blocks.h).
+// and finishes the survivors with ray_triangle_plane (cpu/triangle_blocks.h).
 struct TriEdges {
   vec3 a;    // p0 - origin, scaled by 2^ks (the plane distance is taken from it)
   int ks;
@@ -116,20 +116,25 @@ LS_FN bool ray_triangle_edges(IN(TriRay) r, IN(vec3) p0, IN(vec3) p1, IN(vec3) p
   return true;
 }
 
-// The second half: the signs of the edge functions, then the distance from the triangle's plane and
-// the barycentric weights.
-LS_FN bool ray_triangle_finish(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(vec3) p1, IN(vec3) p2,
-                               IN(TriEdges) e, OUT(float) t, OUT(float) u, OUT(float) v) {
-  if ((e.eu < 0.0f || e.ev < 0.0f || e.ew < 0.0f) && (e.eu > 0.0f || e.ev > 0.0f || e.ew > 0.0f)) return false;
-  precise float det = e.eu + e.ev + e.ew;
-  if (det == 0.0f) return false;
-  // The plane: n from the untranslated edges, scaled by a power of two.
+// The normal of the triangle's plane: n from the untranslated edges, scaled by a power of two.  It
+// depends on the triangle alone (the CPU's fast path keeps it per triangle).
+LS_FN vec3 triangle_plane_normal(IN(vec3) p0, IN(vec3) p1, IN(vec3) p2) {
   precise vec3 f1 = p1 - p0;
   precise vec3 f2 = p2 - p0;
   int kf = unit_exponent(max(max_abs(f1), max_abs(f2)));
   f1 = scale_pow2(f1, kf);
   f2 = scale_pow2(f2, kf);
   precise vec3 n = cross(f1, f2);
+  return n;
+}
+
+// The second half, given the plane's normal n: the signs of the edge functions, then the distance
+// from the plane and the barycentric weights.
+LS_FN bool ray_triangle_plane(IN(TriRay) r, float tmin, float tmax, IN(vec3) n, IN(TriEdges) e, OUT(float) t,
+                              OUT(float) u, OUT(float) v) {
+  if ((e.eu < 0.0f || e.ev < 0.0f || e.ew < 0.0f) && (e.eu > 0.0f || e.ev > 0.0f || e.ew > 0.0f)) return false;
+  precise float det = e.eu + e.ev + e.ew;
+  if (det == 0.0f) return false;
   precise float tn = dot_in_order(n, e.a);
   precise float td = dot_in_order(n, r.dir);
   if (td == 0.0f) return false;
@@ -148,7 +153,7 @@ LS_FN bool ray_triangle(IN(TriRay) r, float tmin, float tmax, IN(vec3) p0, IN(ve
                         OUT(float) t, OUT(float) u, OUT(float) v) {
   TriEdges e;
   if (!ray_triangle_edges(r, p0, p1, p2, e)) return false;
-  return ray_triangle_finish(r, tmin, tmax, p0, p1, p2, e, t, u, v);
+  return ray_triangle_plane(r, tmin, tmax, triangle_plane_normal(p0, p1, p2), e, t, u, v);
 }
 
 #ifdef __cplusplus
