@@ -2,14 +2,21 @@
 // reference kernels: every hit record bit for bit (t, u, v, ids) and the Line Space counters, for
 // closest and any hit, on the built-in scenes and random ones, every structure, both widths.
 #include "accel.h"
+#include "exact_wide_bvh.h"
+#include "triangle_blocks.h"
 #include "load_scene.h"
 #include "ray_generators.h"
 
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <bit>
+#include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
+#include <map>
+#include <set>
 #include <random>
 #include <sstream>
 
@@ -245,4 +252,176 @@ TEST_CASE("wide BVH: trace_rays takes the fast path by default and the reference
   CHECK_THROWS_AS(ls::parse_traversal("simd"), ls::InputError);
   o.wide_width = 16;
   CHECK_THROWS_AS(ls::build_accel(scene, ls::parse_structure("bvh"), o), ls::InputError);
+}
+
+TEST_CASE("wide BVH: rays with infinite or NaN components take the ordered walk and agree", "[wide]") {
+  const ls::Scene scene = random_scene(6);
+  const float inf = kInf, nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<lsk::Ray> rays;
+  Rng rng(17);
+  for (int i = 0; i < 600; ++i) {
+    glm::vec3 o = rng.vec(-4.0f, 4.0f), d = rng.vec(-1.0f, 1.0f);
+    const float bad = i % 2 ? inf : nan;
+    switch (i % 4) {
+      case 0: o[i / 4 % 3] = i % 8 < 4 ? bad : -bad; break;
+      case 1: d[i / 4 % 3] = i % 8 < 4 ? bad : -bad; break;
+      case 2: rays.push_back(ray(o, d, nan)); continue;
+      default: rays.push_back(ray(o, d, -inf, inf)); continue;
+    }
+    rays.push_back(ray(o, d));
+  }
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
+    const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
+    std::vector<lsk::Hit> ref(rays.size()), fast(rays.size());
+    ls::trace_rays(a, rays.data(), ref.data(), rays.size(), false, nullptr, ls::Traversal::Reference);
+    ls::trace_rays(a, rays.data(), fast.data(), rays.size(), false, nullptr, ls::Traversal::Fast);
+    size_t mismatches = 0;
+    for (size_t i = 0; i < rays.size(); ++i) mismatches += std::memcmp(&ref[i], &fast[i], sizeof(lsk::Hit)) != 0;
+    INFO(s);
+    CHECK(mismatches == 0);
+  }
+}
+
+TEST_CASE("scale_pow2: the exponent-field shortcut gives the exact product, saturated and flushed as documented", "[wide]") {
+  // The kernel's contract: x * 2^e exactly; +-inf when float_exponent(x) + e > 127; a zero of x's
+  // sign when it is < -126 (a denormal x counts as exponent -127); zero, inf and NaN stay.
+  auto expected = [](float x, int e) {
+    if (x == 0.0f || std::isinf(x) || std::isnan(x)) return x;
+    const int field = int((std::bit_cast<uint32_t>(x) >> 23) & 255u);
+    const int ex = field - 127;
+    if (ex + e > 127) return x < 0.0f ? -kInf : kInf;
+    if (ex + e < -126) return 0.0f * x;
+    return float(std::ldexp(double(x), e));  // exact in double, representable in float
+  };
+  Rng rng(3);
+  size_t checked = 0, mismatches = 0;
+  for (uint32_t field = 0; field < 256; ++field)
+    for (uint32_t k = 0; k < 6; ++k) {
+      const uint32_t mantissa = k == 0 ? 0u : k == 1 ? 1u : k == 2 ? 0x7FFFFFu : uint32_t(rng.gen()) & 0x7FFFFFu;
+      for (uint32_t sign : {0u, 0x80000000u}) {
+        const float x = std::bit_cast<float>(sign | field << 23 | mantissa);
+        for (int e = -260; e <= 260; ++e) {
+          const float got = lsk::scale_pow2(x, e), want = expected(x, e);
+          ++checked;
+          if (std::isnan(want) ? !std::isnan(got) : std::bit_cast<uint32_t>(got) != std::bit_cast<uint32_t>(want)) {
+            if (mismatches++ < 5) UNSCOPED_INFO("x bits " << std::hex << std::bit_cast<uint32_t>(x) << std::dec << ", e " << e);
+          }
+        }
+      }
+    }
+  CHECK(checked > 1000000);
+  CHECK(mismatches == 0);
+}
+
+TEST_CASE("four-lane scale_pow2 of the triangle blocks equals the kernel's", "[wide]") {
+  Rng rng(5);
+  size_t mismatches = 0;
+  for (int e = -126; e <= 126; ++e) {
+    const ls::Int4 one_minus_e(1 - e);
+    const ls::Float4 pow2_e(lsk::pow2(e));
+    for (uint32_t field = 0; field < 256; ++field) {
+      alignas(16) float x[4];
+      for (int l = 0; l < 4; ++l) {
+        const uint32_t mantissa = l == 0 ? 0u : l == 1 ? 1u : uint32_t(rng.gen()) & 0x7FFFFFu;
+        x[l] = std::bit_cast<float>((l == 3 ? 0x80000000u : 0u) | field << 23 | mantissa);
+      }
+      alignas(16) float got[4];
+      ls::block_lanes::scale_pow2(ls::Float4::load_aligned(x), one_minus_e, pow2_e).store_aligned(got);
+      for (int l = 0; l < 4; ++l) {
+        const float want = lsk::scale_pow2(x[l], e);
+        if (!(std::isnan(want) && std::isnan(got[l])) && std::bit_cast<uint32_t>(got[l]) != std::bit_cast<uint32_t>(want))
+          ++mismatches;
+      }
+    }
+  }
+  CHECK(mismatches == 0);
+}
+
+TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
+  const ls::Scene scene = random_scene(8);
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3", "2l-ls:0:3"}) {
+    INFO(s);
+    const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
+    const std::vector<uint32_t> none;
+    const std::vector<uint32_t>& node_ls = a.spec.line_space() ? a.node_ls : none;
+    const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
+    const ls::ExactWideTree tree = ls::build_exact_wide_tree(a.nodes, node_ls, roots);
+    // The entries are the topmost inner nodes with no Line Space node strictly below them.
+    std::function<bool(uint32_t)> holds_ls = [&](uint32_t b) {
+      if (!node_ls.empty() && node_ls[b] != lsk::LS_INVALID) return true;
+      return a.nodes[b].count == 0 && (holds_ls(a.nodes[b].first) || holds_ls(a.nodes[b].first + 1));
+    };
+    size_t entries = 0, ls_entries = 0, wrong_entries = 0;
+    std::function<void(uint32_t, bool)> walk = [&](uint32_t b, bool above_entry) {
+      const lsk::BvhNode& n = a.nodes[b];
+      const bool entry = n.count == 0 && !holds_ls(n.first) && !holds_ls(n.first + 1) && !above_entry;
+      wrong_entries += (tree.entry_of[b] != lsk::LS_INVALID) != entry;
+      entries += entry;
+      ls_entries += entry && !node_ls.empty() && node_ls[b] != lsk::LS_INVALID;
+      if (n.count == 0) {
+        walk(n.first, above_entry || entry);
+        walk(n.first + 1, above_entry || entry);
+      }
+    };
+    std::set<uint32_t> distinct(roots.begin(), roots.end());
+    for (uint32_t r : distinct)
+      if (r != lsk::LS_INVALID) walk(r, false);
+    CHECK(wrong_entries == 0);
+    CHECK(entries == tree.entries);
+    if (a.spec.line_space()) CHECK(ls_entries == a.ls_info.ls_nodes);
+    // Below each entry every triangle sits in exactly one leaf lane, inside that lane's box.
+    for (uint32_t r : distinct) {
+      if (r == lsk::LS_INVALID) continue;
+      std::function<void(uint32_t)> check_entry = [&](uint32_t b) {
+        const lsk::BvhNode& n = a.nodes[b];
+        if (tree.entry_of[b] == lsk::LS_INVALID) {
+          if (n.count == 0) {
+            check_entry(n.first);
+            check_entry(n.first + 1);
+          }
+          return;
+        }
+        std::function<uint32_t(uint32_t)> range_count = [&](uint32_t c) -> uint32_t {
+          return a.nodes[c].count > 0 ? a.nodes[c].count : range_count(a.nodes[c].first) + range_count(a.nodes[c].first + 1);
+        };
+        std::map<uint32_t, int> seen;
+        size_t outside = 0, unused_not_nan = 0, narrow = 0, big_merged = 0;
+        std::function<void(uint32_t)> visit = [&](uint32_t w) {
+          const ls::ExactWideNode& node = tree.nodes[w];
+          int used = 0;
+          for (int l = 0; l < ls::ExactWideNode::kWidth; ++l) {
+            if (node.child[l] == lsk::LS_INVALID) {
+              unused_not_nan += !std::isnan(node.lo[0][l]) || !std::isnan(node.hi[2][l]);
+              continue;
+            }
+            ++used;
+            if (node.count[l] == 0) {
+              visit(node.child[l]);
+              continue;
+            }
+            bool binary_leaf = false;  // a leaf lane is a binary leaf or a merged subtree of <= kLeafMax
+            for (const lsk::BvhNode& n : a.nodes) binary_leaf |= n.count == node.count[l] && n.first == node.child[l];
+            big_merged += !binary_leaf && node.count[l] > ls::ExactWideTree::kLeafMax;
+            for (uint32_t k = 0; k < node.count[l]; ++k) {
+              const uint32_t i = node.child[l] + k;
+              ++seen[i];
+              for (const glm::vec4* v : {&a.tris[i].v0, &a.tris[i].v1, &a.tris[i].v2})
+                for (int ax = 0; ax < 3; ++ax) outside += (*v)[ax] < node.lo[ax][l] || (*v)[ax] > node.hi[ax][l];
+            }
+          }
+          narrow += used < 2;
+        };
+        visit(tree.entry_of[b]);
+        CHECK(outside == 0);
+        CHECK(unused_not_nan == 0);
+        CHECK(narrow == 0);
+        CHECK(big_merged == 0);
+        CHECK(seen.size() == range_count(b));
+        size_t repeated = 0;
+        for (const auto& [i, times] : seen) repeated += times != 1;
+        CHECK(repeated == 0);
+      };
+      check_entry(r);
+    }
+  }
 }
