@@ -217,18 +217,20 @@ struct ExactBoxRay {
   bool any_parallel;
 };
 
-ExactBoxRay make_exact_box_ray(const BoxRay& r) {
+ExactBoxRay make_exact_box_ray(const vec3& origin, const vec3& inv_dir) {
+  constexpr float big = 3.0e38f;
   ExactBoxRay e;
+  constexpr uint32_t lo = uint32_t(offsetof(ExactWideNode, lo));
+  constexpr uint32_t hi = uint32_t(offsetof(ExactWideNode, hi));
   for (int a = 0; a < 3; ++a) {
-    e.origin[a] = Float4(r.origin[a]);
-    e.inv_dir[a] = Float4(r.inv_dir[a]);
-    const uint32_t lo = uint32_t(offsetof(ExactWideNode, lo) + sizeof(float[4]) * size_t(a));
-    const uint32_t hi = uint32_t(offsetof(ExactWideNode, hi) + sizeof(float[4]) * size_t(a));
-    e.enter[a] = r.near_is_lo[a] ? lo : hi;
-    e.leave[a] = r.near_is_lo[a] ? hi : lo;
-    e.parallel[a] = r.parallel[a];
+    e.origin[a] = Float4(origin[a]);
+    e.inv_dir[a] = Float4(inv_dir[a]);
+    const uint32_t row = uint32_t(sizeof(float[4])) * uint32_t(a);
+    e.enter[a] = row + (inv_dir[a] >= 0.0f ? lo : hi);
+    e.leave[a] = row + (inv_dir[a] >= 0.0f ? hi : lo);
+    e.parallel[a] = std::abs(inv_dir[a]) == big;
   }
-  e.any_parallel = r.any_parallel;
+  e.any_parallel = e.parallel[0] || e.parallel[1] || e.parallel[2];
   return e;
 }
 
@@ -359,14 +361,13 @@ struct ExactWalk {
 
 // One ray's whole order-free walk below `entry`.
 template <class LeafFn, class PrefetchFn>
-inline void walk_exact(const ExactWideTree& tree, uint entry, const BoxRay& ray, float tmin, const Hit& hit, LeafFn&& leaf,
-                       PrefetchFn&& prefetch_leaf) {
+inline void walk_exact(const ExactWideTree& tree, uint entry, const ExactBoxRay& ray, float tmin, const Hit& hit,
+                       LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
   if (hit.t != hit.t) return;  // a NaN tmax: no t is <= it, the reference finds nothing either
-  const ExactBoxRay box_ray = make_exact_box_ray(ray);
   const Float4 tmin4(tmin);
   ExactWalk walk;
   walk.start(entry);
-  while (walk.step(tree, box_ray, tmin4, hit, leaf, prefetch_leaf)) {
+  while (walk.step(tree, ray, tmin4, hit, leaf, prefetch_leaf)) {
   }
 }
 
@@ -434,11 +435,16 @@ class WideTracer final : public FastTracer {
                  bool any_hit, bool use_ls, Hit& hit, uint& hit_prim) const {
     const lsk::TriRay tri_ray = lsk::make_tri_ray(origin, dir);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
-    const BoxRay box_ray = make_box_ray(origin, inv_dir);
     const bool order_free = !any_hit && order_free_ray(origin, dir, tmin);
+    ExactBoxRay exact_ray;  // made once, at the first order-free walk
+    bool exact_ray_made = false;
     auto exact = [&](uint entry) {
+      if (!exact_ray_made) {
+        exact_ray = make_exact_box_ray(origin, inv_dir);
+        exact_ray_made = true;
+      }
       walk_exact(
-          part_->exact, entry, box_ray, tmin, hit,
+          part_->exact, entry, exact_ray, tmin, hit,
           [&](uint lane, uint n) { trace_blocks(c, blocks_, lane, n, tri_ray, tmin, instance, false, hit, hit_prim); },
           [&](uint lane) { prefetch_block(lane / 4u); });
     };
@@ -470,7 +476,7 @@ class WideTracer final : public FastTracer {
     if (order_free && root_entry != LS_INVALID)  // a Line Space at the root, then the whole tree order-free
       return visit(root_ls, false, 0u, 0u, LS_INVALID, root_entry) == Visit::Stop;
     auto leaf_block = [&](uint lane) { return reinterpret_cast<const char*>(&blocks_[lane / 4u]); };
-    return walk(part_->tree, part_->tree.wide_of[root], box_ray, tmin, hit, visit, leaf_block);
+    return walk(part_->tree, part_->tree.wide_of[root], make_box_ray(origin, inv_dir), tmin, hit, visit, leaf_block);
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
@@ -499,13 +505,13 @@ class WideTracer final : public FastTracer {
       return false;
     };
     const lsk::BvhNode& root = c.top_nodes[0];
-    const BoxRay box_ray = make_box_ray(ray.origin, inv_dir);
     if (root.count > 0)
       instances(root.first, root.count);
     else if (!any_hit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no Line Space decision depends on the order
-      walk_exact(top_exact_, top_exact_.entry_of[0], box_ray, ray.tmin, hit, instances, [](uint) {});
+      walk_exact(top_exact_, top_exact_.entry_of[0], make_exact_box_ray(ray.origin, inv_dir), ray.tmin, hit, instances,
+                 [](uint) {});
     else
-      walk(top_, top_.wide_of[0], box_ray, ray.tmin, hit,
+      walk(top_, top_.wide_of[0], make_box_ray(ray.origin, inv_dir), ray.tmin, hit,
            [&](uint, bool leaf, uint first, uint count, uint, uint) {
              if (!leaf) return Visit::Descend;
              return instances(first, count) ? Visit::Stop : Visit::Skip;

@@ -74,6 +74,9 @@ LS_FN vec3 normalize_in_order(IN(vec3) v) {
   return r;
 }
 
+// v[i] for i in 0..2, spelled as selects: C++'s glm::vec3 indexes through a switch.
+LS_FN float component(IN(vec3) v, uint i) { return i == 0u ? v.x : (i == 1u ? v.y : v.z); }
+
 LS_FN float max_abs(IN(vec3) v) { return max(max(abs(v.x), abs(v.y)), abs(v.z)); }
 
 #ifdef __cplusplus

@@ -48,14 +48,14 @@ LS_FN TriRay make_tri_ray(IN(vec3) origin, IN(vec3) dir) {
   r.kz = ad.x >= ad.y ? (ad.x >= ad.z ? 0u : 2u) : (ad.y >= ad.z ? 1u : 2u);
   r.kx = (r.kz + 1u) % 3u;
   r.ky = (r.kx + 1u) % 3u;
-  if (r.dir[r.kz] < 0.0f) {  // keep the winding: swap the other two axes
+  if (component(r.dir, r.kz) < 0.0f) {  // keep the winding: swap the other two axes
     uint k = r.kx;
     r.kx = r.ky;
     r.ky = k;
   }
-  r.sx = r.dir[r.kx] / r.dir[r.kz];
-  r.sy = r.dir[r.ky] / r.dir[r.kz];
-  r.sz = 1.0f / r.dir[r.kz];
+  r.sx = component(r.dir, r.kx) / component(r.dir, r.kz);
+  r.sy = component(r.dir, r.ky) / component(r.dir, r.kz);
+  r.sz = 1.0f / component(r.dir, r.kz);
   r.pad0 = 0.0f;
   r.pad1 = 0.0f;
   r.pad2 = 0.0f;
@@ -91,12 +91,12 @@ LS_FN bool ray_triangle_edges(IN(TriRay) r, IN(vec3) p0, IN(vec3) p1, IN(vec3) p
   a = scale_pow2(a, ks);
   b = scale_pow2(b, ks);
   c = scale_pow2(c, ks);
-  precise float ax = a[r.kx] - r.sx * a[r.kz];
-  precise float ay = a[r.ky] - r.sy * a[r.kz];
-  precise float bx = b[r.kx] - r.sx * b[r.kz];
-  precise float by = b[r.ky] - r.sy * b[r.kz];
-  precise float cx = c[r.kx] - r.sx * c[r.kz];
-  precise float cy = c[r.ky] - r.sy * c[r.kz];
+  precise float ax = component(a, r.kx) - r.sx * component(a, r.kz);
+  precise float ay = component(a, r.ky) - r.sy * component(a, r.kz);
+  precise float bx = component(b, r.kx) - r.sx * component(b, r.kz);
+  precise float by = component(b, r.ky) - r.sy * component(b, r.kz);
+  precise float cx = component(c, r.kx) - r.sx * component(c, r.kz);
+  precise float cy = component(c, r.ky) - r.sy * component(c, r.kz);
   precise float eu = cx * by - cy * bx;
   precise float ev = ax * cy - ay * cx;
   precise float ew = bx * ay - by * ax;
