@@ -40,28 +40,6 @@ using lsk::LS_INVALID;
 using lsk::uint;
 using lsk::vec3;
 
-// The per-ray constants of the box tests.
-struct BoxRay {
-  float origin[3];
-  float inv_dir[3];
-  bool parallel[3];  // safe_reciprocal's huge value: the ray runs parallel to that slab
-  bool any_parallel;
-  bool near_is_lo[3];  // inv_dir >= 0: the slab is entered through its lower plane
-};
-
-BoxRay make_box_ray(const vec3& origin, const vec3& inv_dir) {
-  constexpr float big = 3.0e38f;
-  BoxRay r;
-  for (int a = 0; a < 3; ++a) {
-    r.origin[a] = origin[a];
-    r.inv_dir[a] = inv_dir[a];
-    r.parallel[a] = std::abs(inv_dir[a]) == big;
-    r.near_is_lo[a] = inv_dir[a] >= 0.0f;
-  }
-  r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
-  return r;
-}
-
 // Rays the order-free walk takes: finite origin, direction and tmin (its slab arithmetic is the
 // reference's only there; anything else follows the reference's order in the treelets).
 bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
@@ -69,35 +47,97 @@ bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
          std::isfinite(dir.y) && std::isfinite(dir.z) && !std::isnan(tmin);
 }
 
-// lsk::ray_box for every lane of a wide node: entry distance and widened exit distance; a lane is hit
-// when tnear <= tfar.  Same operations in the same order as the scalar kernel (slab_interval,
-// widen_distance), and no fused multiply-adds (-ffp-contract=off), hence the same bits.
-template <int K>
-inline void box_tests(const WideNode<K>& node, const BoxRay& r, float tmin, float tmax, float* tnear, float* tfar) {
+// The per-ray constants of the SIMD box tests (lsk::ray_box on a node's lanes), broadcast once into
+// batches of Batch floats, for nodes that keep per axis a row of lower and a row of upper bounds.
+template <class Batch>
+struct SlabRay {
+  Batch origin[3];
+  Batch inv_dir[3];
+  uint32_t lo[3];     // byte offset in the node of each axis' lower and upper rows
+  uint32_t hi[3];
+  uint32_t enter[3];  // the row the ray enters each slab through (lo where inv_dir >= 0), and leaves
+  uint32_t leave[3];
+  bool parallel[3];   // safe_reciprocal's huge value: the ray runs parallel to that slab
+  bool any_parallel;
+  bool by_sign;       // entry and exit taken from enter/leave (a finite ray), else as min and max
+};
+
+template <class Batch, class Node>
+SlabRay<Batch> make_slab_ray(const vec3& origin, const vec3& inv_dir, bool finite) {
   constexpr float big = 3.0e38f;
-  constexpr float slack = lsk::LS_WIDEN_SLACK;
-  for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
-    FloatBatch tn[3];
-    FloatBatch tf[3];
-    for (int a = 0; a < 3; ++a) {
-      const FloatBatch lo = FloatBatch::load_aligned(&node.lo[a][c]);
-      const FloatBatch hi = FloatBatch::load_aligned(&node.hi[a][c]);
-      const FloatBatch o(r.origin[a]);
-      if (r.any_parallel && r.parallel[a]) {
-        const auto inside = (o >= lo) && (o <= hi);
-        tn[a] = xsimd::select(inside, FloatBatch(-big), FloatBatch(big));
-        tf[a] = xsimd::select(inside, FloatBatch(big), FloatBatch(-big));
-      } else {
-        const FloatBatch inv(r.inv_dir[a]);
-        const FloatBatch t0 = (lo - o) * inv;
-        const FloatBatch t1 = (hi - o) * inv;
-        tn[a] = glm_min(t0, t1);
-        tf[a] = glm_max(t0, t1);
-      }
+  constexpr uint32_t row = uint32_t(sizeof(Node::lo[0]));
+  SlabRay<Batch> r;
+  for (int a = 0; a < 3; ++a) {
+    r.origin[a] = Batch(origin[a]);
+    r.inv_dir[a] = Batch(inv_dir[a]);
+    r.lo[a] = uint32_t(offsetof(Node, lo)) + row * uint32_t(a);
+    r.hi[a] = uint32_t(offsetof(Node, hi)) + row * uint32_t(a);
+    r.enter[a] = inv_dir[a] >= 0.0f ? r.lo[a] : r.hi[a];
+    r.leave[a] = inv_dir[a] >= 0.0f ? r.hi[a] : r.lo[a];
+    r.parallel[a] = std::abs(inv_dir[a]) == big;
+  }
+  r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
+  r.by_sign = finite;
+  return r;
+}
+
+// lsk::ray_box on the lanes of a node whose rows start at `rows` (the node, plus the byte offset of
+// the first lane of the batch): the entry distance and the widened exit distance; a lane is hit
+// when near <= widened.  The scalar kernel's operations (slab_interval, widen_distance) lane by lane,
+// without fused multiply-adds (-ffp-contract=off).  For a finite ray each slab's entry and exit come
+// from the planes its direction says, not as min and max of the two: the same values (rounding is
+// monotone), up to the sign of a zero, which no comparison sees.
+template <bool kBySign, bool kParallel, class Batch>
+LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
+                                 Batch& widened) {
+  constexpr float big = 3.0e38f;
+  auto row = [&](uint32_t offset) { return Batch::load_aligned(reinterpret_cast<const float*>(rows + offset)); };
+  Batch tn[3];
+  Batch tf[3];
+  for (int a = 0; a < 3; ++a) {
+    if (kParallel && r.parallel[a]) {
+      const auto inside = (r.origin[a] >= row(r.lo[a])) && (r.origin[a] <= row(r.hi[a]));
+      tn[a] = xsimd::select(inside, Batch(-big), Batch(big));
+      tf[a] = xsimd::select(inside, Batch(big), Batch(-big));
+    } else if (kBySign) {
+      tn[a] = (row(r.enter[a]) - r.origin[a]) * r.inv_dir[a];
+      tf[a] = (row(r.leave[a]) - r.origin[a]) * r.inv_dir[a];
+    } else {
+      const Batch t0 = (row(r.lo[a]) - r.origin[a]) * r.inv_dir[a];
+      const Batch t1 = (row(r.hi[a]) - r.origin[a]) * r.inv_dir[a];
+      tn[a] = glm_min(t0, t1);
+      tf[a] = glm_max(t0, t1);
     }
-    const FloatBatch near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], FloatBatch(tmin)));
-    const FloatBatch far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], FloatBatch(tmax)));
-    const FloatBatch widened = far + xsimd::abs(far) * FloatBatch(slack);
+  }
+  near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], tmin));
+  const Batch far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], tmax));
+  widened = far + xsimd::abs(far) * Batch(lsk::LS_WIDEN_SLACK);
+}
+
+// slab_tests with its per-ray choices made once per call: a ray parallel to no slab (nearly all)
+// runs straight-line code.
+template <bool kBySign, class Batch>
+LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
+                                 Batch& widened) {
+  if (r.any_parallel)
+    slab_tests<kBySign, true>(rows, r, tmin, tmax, near, widened);
+  else
+    slab_tests<kBySign, false>(rows, r, tmin, tmax, near, widened);
+}
+
+// The box tests of every lane of a treelet: entry distances and widened exit distances.
+template <int K>
+inline void box_tests(const WideNode<K>& node, const SlabRay<FloatBatch>& r, const FloatBatch& tmin, float tmax, float* tnear,
+                      float* tfar) {
+  const FloatBatch tmax_batch(tmax);
+  for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
+    FloatBatch near;
+    FloatBatch widened;
+    const char* rows = reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c);
+    if (r.by_sign)
+      slab_tests<true>(rows, r, tmin, tmax_batch, near, widened);
+    else
+      slab_tests<false>(rows, r, tmin, tmax_batch, near, widened);
     near.store_aligned(tnear + c);
     widened.store_aligned(tfar + c);
   }
@@ -119,9 +159,9 @@ enum class Visit { Descend, Skip, Stop };
 // ignored by the reference's min and never changes: the second test is then skipped.)  The walk is
 // depth first, so a node's results sit in the slot of its wide depth until every pending position of
 // it has been popped.
-template <int K, class VisitFn, class PrefetchFn>
-inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin, const Hit& hit, VisitFn&& visit,
-                 PrefetchFn&& prefetch_leaf) {
+template <int K, class VisitFn>
+inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray, float tmin, const Hit& hit, VisitFn&& visit) {
+  const FloatBatch tmin_batch(tmin);
   using Node = WideNode<K>;
   constexpr int kMaxDepth = lsk::TraceContext::LS_STACK_SIZE / K + 1;
   alignas(64) float tnear[kMaxDepth][Node::kPadded];
@@ -144,17 +184,7 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
     if (v == Visit::Stop) return true;
     if (v == Visit::Descend && !leaf) {
       if (root) {
-        box_tests(node, ray, tmin, hit.t, tnear[depth], tfar[depth]);
-        // Start loading what the boxes say may come next: the traversal is bound by memory latency.
-        for (uint p = Node::kBottom; p < 2u * Node::kBottom; ++p) {
-          const uint l = p - 2u;
-          if (!(tnear[depth][l] <= tfar[depth][l])) continue;
-          const char* next = node.count[l] == 0u ? reinterpret_cast<const char*>(&tree.nodes[node.first[l]])
-                                                 : prefetch_leaf(node.tri_lane[l]);
-          const size_t bytes = node.count[l] == 0u ? sizeof(Node) : sizeof(TriBlock);
-          if (next)
-            for (size_t line = 0; line < bytes; line += 64) __builtin_prefetch(next + line);
-        }
+        box_tests(node, ray, tmin_batch, hit.t, tnear[depth], tfar[depth]);
       }
       const float* tn = tnear[depth];
       const float* tf = tfar[depth];
@@ -206,63 +236,17 @@ inline bool walk(const WideTree<K>& tree, uint w, const BoxRay& ray, float tmin,
   }
 }
 
-// The per-ray constants of the exact wide nodes' box tests, broadcast once: for each axis the
-// origin, the reciprocal direction and where in a node the slab's entry and exit planes are.
-struct ExactBoxRay {
-  Float4 origin[3];
-  Float4 inv_dir[3];
-  uint32_t enter[3];  // byte offset in ExactWideNode of the entry plane's row (lo or hi)
-  uint32_t leave[3];
-  bool parallel[3];  // safe_reciprocal's huge value: the ray runs parallel to that slab
-  bool any_parallel;
-};
-
-ExactBoxRay make_exact_box_ray(const vec3& origin, const vec3& inv_dir) {
-  constexpr float big = 3.0e38f;
-  ExactBoxRay e;
-  constexpr uint32_t lo = uint32_t(offsetof(ExactWideNode, lo));
-  constexpr uint32_t hi = uint32_t(offsetof(ExactWideNode, hi));
-  for (int a = 0; a < 3; ++a) {
-    e.origin[a] = Float4(origin[a]);
-    e.inv_dir[a] = Float4(inv_dir[a]);
-    const uint32_t row = uint32_t(sizeof(float[4])) * uint32_t(a);
-    e.enter[a] = row + (inv_dir[a] >= 0.0f ? lo : hi);
-    e.leave[a] = row + (inv_dir[a] >= 0.0f ? hi : lo);
-    e.parallel[a] = std::abs(inv_dir[a]) == big;
-  }
-  e.any_parallel = e.parallel[0] || e.parallel[1] || e.parallel[2];
-  return e;
-}
+using ExactBoxRay = SlabRay<Float4>;
 
 // ray_box on the four children of an exact wide node against [tmin, tmax]: the lanes hit (bit l) and
-// their entry distances.  The scalar kernel's arithmetic, except that each slab's entry and exit are
-// taken from the plane the ray's direction says instead of as min and max of the two: for a finite
-// ray the same values (rounding is monotone), up to the sign of a zero, which no comparison sees.
-// An unused lane's box is NaN, which no ray enters: its entry distance is NaN on an axis the ray
-// crosses (glm_max keeps a NaN first operand) and +big on one it runs along.
+// their entry distances.  An unused lane's box is NaN, which no ray enters: its entry distance is
+// NaN on an axis the ray crosses (glm_max keeps a NaN first operand) and +big on one it runs along.
+template <bool kParallel>
 LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode& node, const ExactBoxRay& r, const Float4& tmin, float tmax,
                                           float* tnear) {
-  constexpr float big = 3.0e38f;
-  const char* base = reinterpret_cast<const char*>(&node);
-  Float4 tn[3];
-  Float4 tf[3];
-  for (int a = 0; a < 3; ++a) {
-    if (r.any_parallel && r.parallel[a]) {
-      const Float4 lo = Float4::load_aligned(node.lo[a]);
-      const Float4 hi = Float4::load_aligned(node.hi[a]);
-      const auto inside = (r.origin[a] >= lo) && (r.origin[a] <= hi);
-      tn[a] = xsimd::select(inside, Float4(-big), Float4(big));
-      tf[a] = xsimd::select(inside, Float4(big), Float4(-big));
-    } else {
-      const Float4 enter = Float4::load_aligned(reinterpret_cast<const float*>(base + r.enter[a]));
-      const Float4 leave = Float4::load_aligned(reinterpret_cast<const float*>(base + r.leave[a]));
-      tn[a] = (enter - r.origin[a]) * r.inv_dir[a];
-      tf[a] = (leave - r.origin[a]) * r.inv_dir[a];
-    }
-  }
-  const Float4 near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], tmin));
-  const Float4 far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], Float4(tmax)));
-  const Float4 widened = far + xsimd::abs(far) * Float4(lsk::LS_WIDEN_SLACK);
+  Float4 near;
+  Float4 widened;
+  slab_tests<true, kParallel>(reinterpret_cast<const char*>(&node), r, tmin, Float4(tmax), near, widened);
   near.store_aligned(tnear);
   return lane_bits(near <= widened);
 }
@@ -305,7 +289,7 @@ struct ExactWalk {
   // Visits the next wide node or leaf; leaf(child, count) tests a leaf's primitives against the
   // running hit.  When the boxes admit several children, all of them start loading at once.  False
   // when the walk is over.
-  template <class LeafFn, class PrefetchFn>
+  template <bool kParallel, class LeafFn, class PrefetchFn>
   LS_ALWAYS_INLINE bool step(const ExactWideTree& tree, const ExactBoxRay& ray, const Float4& tmin, const Hit& hit,
                              LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
     if (count != 0u) {
@@ -314,7 +298,7 @@ struct ExactWalk {
     }
     const ExactWideNode& node = tree.nodes[child];
     alignas(16) float tn[4];
-    unsigned lanes = exact_box_tests(node, ray, tmin, hit.t, tn);
+    unsigned lanes = exact_box_tests<kParallel>(node, ray, tmin, hit.t, tn);
     if (lanes == 0u) return pop(hit.t);
     unsigned near = unsigned(std::countr_zero(lanes));
     lanes &= lanes - 1u;
@@ -367,8 +351,12 @@ inline void walk_exact(const ExactWideTree& tree, uint entry, const ExactBoxRay&
   const Float4 tmin4(tmin);
   ExactWalk walk;
   walk.start(entry);
-  while (walk.step(tree, ray, tmin4, hit, leaf, prefetch_leaf)) {
-  }
+  if (ray.any_parallel)  // rays parallel to a slab are rare: the others run straight-line box tests
+    while (walk.step<true>(tree, ray, tmin4, hit, leaf, prefetch_leaf)) {
+    }
+  else
+    while (walk.step<false>(tree, ray, tmin4, hit, leaf, prefetch_leaf)) {
+    }
 }
 
 // What the fast path keeps of the object level: the treelets and the exact wide tree of the object
@@ -440,7 +428,7 @@ class WideTracer final : public FastTracer {
     bool exact_ray_made = false;
     auto exact = [&](uint entry) {
       if (!exact_ray_made) {
-        exact_ray = make_exact_box_ray(origin, inv_dir);
+        exact_ray = make_slab_ray<Float4, ExactWideNode>(origin, inv_dir, true);
         exact_ray_made = true;
       }
       walk_exact(
@@ -475,8 +463,8 @@ class WideTracer final : public FastTracer {
       return visit(root_ls, true, node.first, node.count, part_->blocks.lane_of[root], LS_INVALID) == Visit::Stop;
     if (order_free && root_entry != LS_INVALID)  // a Line Space at the root, then the whole tree order-free
       return visit(root_ls, false, 0u, 0u, LS_INVALID, root_entry) == Visit::Stop;
-    auto leaf_block = [&](uint lane) { return reinterpret_cast<const char*>(&blocks_[lane / 4u]); };
-    return walk(part_->tree, part_->tree.wide_of[root], make_box_ray(origin, inv_dir), tmin, hit, visit, leaf_block);
+    return walk(part_->tree, part_->tree.wide_of[root],
+                make_slab_ray<FloatBatch, WideNode<K>>(origin, inv_dir, order_free_ray(origin, dir, tmin)), tmin, hit, visit);
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
@@ -508,15 +496,17 @@ class WideTracer final : public FastTracer {
     if (root.count > 0)
       instances(root.first, root.count);
     else if (!any_hit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no Line Space decision depends on the order
-      walk_exact(top_exact_, top_exact_.entry_of[0], make_exact_box_ray(ray.origin, inv_dir), ray.tmin, hit, instances,
+      walk_exact(top_exact_, top_exact_.entry_of[0], make_slab_ray<Float4, ExactWideNode>(ray.origin, inv_dir, true), ray.tmin,
+                 hit, instances,
                  [](uint) {});
     else
-      walk(top_, top_.wide_of[0], make_box_ray(ray.origin, inv_dir), ray.tmin, hit,
+      walk(top_, top_.wide_of[0],
+           make_slab_ray<FloatBatch, WideNode<K>>(ray.origin, inv_dir, order_free_ray(ray.origin, ray.dir, ray.tmin)),
+           ray.tmin, hit,
            [&](uint, bool leaf, uint first, uint count, uint, uint) {
              if (!leaf) return Visit::Descend;
              return instances(first, count) ? Visit::Stop : Visit::Skip;
-           },
-           [](uint) { return static_cast<const char*>(nullptr); });
+           });
     return lsk::finish_hit(hit);
   }
 

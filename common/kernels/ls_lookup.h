@@ -72,7 +72,9 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   precise vec3 e1 = vec3(tri.v1) - p0;
   precise vec3 e2 = vec3(tri.v2) - p0;
   int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
-  precise vec3 n = cross(scale_pow2(e1, ke), scale_pow2(e2, ke));
+  vec3 e1s = scale_pow2(e1, ke);
+  vec3 e2s = scale_pow2(e2, ke);
+  precise vec3 n = cross(e1s, e2s);
   precise float denom = dot_in_order(dir, n);
   if (denom == 0.0f || dot_in_order(n, n) == 0.0f) {
     ls_counters.refused_parallel += 1u;
@@ -90,8 +92,9 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
   // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
   precise vec3 q = origin + dir * t - p0;
   precise float nn = dot_in_order(n, n);
-  precise float b1 = dot_in_order(cross(scale_pow2(q, ke), scale_pow2(e2, ke)), n) / nn;
-  precise float b2 = dot_in_order(cross(scale_pow2(e1, ke), scale_pow2(q, ke)), n) / nn;
+  vec3 qs = scale_pow2(q, ke);
+  precise float b1 = dot_in_order(cross(qs, e2s), n) / nn;
+  precise float b2 = dot_in_order(cross(e1s, qs), n) / nn;
   precise float b0 = 1.0f - b1 - b2;
   uvec4 packed = tri_normals[prim];
   precise vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
