@@ -404,6 +404,20 @@ class WideTracer final : public FastTracer {
       for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], any_hit);
   }
 
+  uint32_t find_candidate(lsk::TraceContext& c, const lsk::LsNode& ls, uint32_t shaft, uint32_t further_rays,
+                          uint32_t instance) const override {
+    for (uint k = 0u; k <= further_rays; ++k) {
+      vec3 a;
+      vec3 d;
+      if (!c.ls_search_segment(ls, shaft, k, a, d)) continue;
+      Hit hit = c.ls_search_hit();
+      uint prim = LS_INVALID;
+      trace_bvh(c, ls.node, a, d, 0.0f, instance, false, false, hit, prim);
+      if (prim != LS_INVALID) return prim;
+    }
+    return LS_INVALID;
+  }
+
   size_t bytes() const override {
     return part_->tree.bytes() + part_->exact.bytes() + part_->blocks.bytes() + top_.bytes() + top_exact_.bytes();
   }

@@ -28,6 +28,11 @@ class FastTracer {
   // this tracer was made for); Line Space counters are added to context.ls_counters.
   virtual void trace(lsk::TraceContext& context, const lsk::Ray* rays, lsk::Hit* hits, size_t count,
                      bool any_hit) const = 0;
+  // lsk::TraceContext::ls_find_candidate on the fast path, the same candidate bit for bit: each
+  // search segment is a closest-hit query in the LS node's own subtree, which the order-free walk
+  // answers (the node is an entry of the exact wide tree).
+  virtual uint32_t find_candidate(lsk::TraceContext& context, const lsk::LsNode& ls, uint32_t shaft, uint32_t further_rays,
+                                  uint32_t instance) const = 0;
   virtual size_t bytes() const = 0;  // the wide nodes and their index
   virtual int width() const = 0;     // 4 or 8
   // A tracer for the same Accel after its top level was rebuilt or refitted (top_level_update.h):

@@ -277,8 +277,10 @@ size_t pack_ls_candidates(Accel& accel, size_t ls_index, const uint32_t* prims) 
 
 void search_line_space(const LsOptions& options, Accel& accel) {
   const auto start = std::chrono::steady_clock::now();
-  // The candidate search, every shaft of every LS node, in parallel.
+  // The candidate search, every shaft of every LS node, in parallel: on the fast path where the
+  // structure has one (the same candidates), else with the reference kernels.
   lsk::TraceContext context = accel.context();
+  const FastTracer* fast = accel.fast.get();
   context.ls_enabled = 0;
   const uint32_t instance = ls_search_instance(accel);
   std::atomic<size_t> empty{0}, nodes_done{0};
@@ -290,8 +292,12 @@ void search_line_space(const LsOptions& options, Accel& accel) {
     ls::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
       throw_if_interrupted();  // TBB cancels the other blocks and rethrows in the caller
       lsk::TraceContext c = context;
-      for (uint32_t s = r.begin(); s != r.end(); ++s)
-        prims[s] = c.ls_find_candidate(ls_node.node, ls_node, s, uint32_t(options.further_rays), instance);
+      if (fast)
+        for (uint32_t s = r.begin(); s != r.end(); ++s)
+          prims[s] = fast->find_candidate(c, ls_node, s, uint32_t(options.further_rays), instance);
+      else
+        for (uint32_t s = r.begin(); s != r.end(); ++s)
+          prims[s] = c.ls_find_candidate(ls_node.node, ls_node, s, uint32_t(options.further_rays), instance);
     });
     empty += pack_ls_candidates(accel, li, prims.data());  // nodes own disjoint words
     const size_t done = ++nodes_done;

@@ -425,3 +425,37 @@ TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
     }
   }
 }
+
+TEST_CASE("wide BVH: the candidate search on the fast path stores the reference kernel's candidates, every shaft", "[wide]") {
+  struct Case {
+    ls::Scene scene;
+    std::string name;
+    std::vector<const char*> structures;
+  };
+  std::vector<Case> cases;
+  cases.push_back({ls::load_scene("builtin:cornell"), "builtin:cornell", {"f-ls:6:3", "2l-ls:2:3"}});
+  cases.push_back({ls::load_scene("builtin:generated:30000:12:5"), "builtin:generated:30000:12:5", {"f-ls:8:2", "2l-ls:0:3"}});
+  cases.push_back({random_scene(9), "random scene 9", {"f-ls:4:3", "2l-ls:3:2"}});
+  for (const Case& k : cases)
+    for (const char* s : k.structures)
+      for (int further : {0, 3}) {
+        ls::AccelOptions o = options(4);
+        o.ls.further_rays = further;
+        const ls::Accel a = ls::build_accel(k.scene, ls::parse_structure(s), o);
+        REQUIRE(a.ls_info.ls_nodes > 0);
+        lsk::TraceContext c = a.context();
+        c.ls_enabled = 0;
+        const uint32_t instance = ls::ls_search_instance(a);
+        size_t shafts = 0, mismatches = 0, found = 0;
+        for (const lsk::LsNode& ls_node : a.ls_nodes)
+          for (uint32_t shaft = 0; shaft < lsk::ls_shaft_count(ls_node.n); ++shaft) {
+            const uint32_t want = c.ls_find_candidate(ls_node.node, ls_node, shaft, uint32_t(further), instance);
+            mismatches += c.ls_candidate(ls_node, shaft) != want;
+            found += want != lsk::LS_INVALID;
+            ++shafts;
+          }
+        INFO(k.name << ", " << s << ", further rays " << further << ": " << shafts << " shafts");
+        CHECK(mismatches == 0);
+        CHECK(found > 0);
+      }
+}
