@@ -111,7 +111,8 @@ LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, cons
   }
   near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], tmin));
   const Batch far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], tmax));
-  widened = far + xsimd::abs(far) * Batch(lsk::LS_WIDEN_SLACK);
+  widened = far + (far & xsimd::bitwise_cast<Batch>(xsimd::batch<int32_t, typename Batch::arch_type>(0x7FFFFFFF))) *
+                       Batch(lsk::LS_WIDEN_SLACK);
 }
 
 // slab_tests with its per-ray choices made once per call: a ray parallel to no slab (nearly all)

@@ -78,13 +78,15 @@ struct BlockEdges {
 LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, BlockEdges& out) {
   using namespace block_lanes;
   const uint32_t axis[3] = {r.kx, r.ky, r.kz};
+  const float origin[3] = {r.origin.x, r.origin.y, r.origin.z};  // indexed in memory, not through glm's switch
+  const Float4 magnitude = xsimd::bitwise_cast<Float4>(Int4(0x7FFFFFFF));  // |x| = x & magnitude
   Float4 d[3][3];  // translated vertices: d[vertex][sheared axis]
   Float4 abs_d[3][3];
   for (int a = 0; a < 3; ++a) {
-    const Float4 o(r.origin[axis[a]]);
+    const Float4 o(origin[axis[a]]);
     for (int k = 0; k < 3; ++k) {
       d[k][a] = Float4::load_aligned(block.v[k][axis[a]]) - o;
-      abs_d[k][a] = xsimd::abs(d[k][a]);
+      abs_d[k][a] = d[k][a] & magnitude;
     }
   }
   const Float4 m = glm_max(glm_max(glm_max(glm_max(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),
