@@ -436,9 +436,18 @@ class WideTracer final : public FastTracer {
   // the order-free walk below the entries it reaches, for closest-hit queries.
   bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, uint instance,
                  bool any_hit, bool use_ls, Hit& hit, uint& hit_prim) const {
-    const lsk::TriRay tri_ray = lsk::make_tri_ray(origin, dir);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
     const bool order_free = !any_hit && order_free_ray(origin, dir, tmin);
+    // Made when first needed: many rays that enter an instance's box never reach a triangle of it.
+    lsk::TriRay tri_ray_made;
+    bool tri_ray_ready = false;
+    auto tri_ray = [&]() -> const lsk::TriRay& {
+      if (!tri_ray_ready) {
+        tri_ray_made = lsk::make_tri_ray(origin, dir);
+        tri_ray_ready = true;
+      }
+      return tri_ray_made;
+    };
     ExactBoxRay exact_ray;  // made once, at the first order-free walk
     bool exact_ray_made = false;
     auto exact = [&](uint entry) {
@@ -446,10 +455,18 @@ class WideTracer final : public FastTracer {
         exact_ray = make_slab_ray<Float4, ExactWideNode>(origin, inv_dir, true);
         exact_ray_made = true;
       }
-      walk_exact(
-          part_->exact, entry, exact_ray, tmin, hit,
-          [&](uint lane, uint n) { trace_blocks(c, blocks_, lane, n, tri_ray, tmin, instance, false, hit, hit_prim); },
-          [&](uint lane) { prefetch_block(lane / 4u); });
+      auto run = [&](auto&& ray_for_leaf) {
+        walk_exact(
+            part_->exact, entry, exact_ray, tmin, hit,
+            [&](uint lane, uint n) { trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, false, hit, hit_prim); },
+            [&](uint lane) { prefetch_block(lane / 4u); });
+      };
+      if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
+        const lsk::TriRay& tr = tri_ray();
+        run([&]() -> const lsk::TriRay& { return tr; });
+      } else {  // an instance's object: many walks end before any leaf
+        run(tri_ray);
+      }
     };
     const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
     const uint root_entry = part_->exact.entry_of[root];
@@ -467,7 +484,7 @@ class WideTracer final : public FastTracer {
         if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
       }
       if (leaf)
-        return trace_blocks(c, blocks_, tri_lane, count, tri_ray, tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
+        return trace_blocks(c, blocks_, tri_lane, count, tri_ray(), tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
                                                                                                         : Visit::Skip;
       if (!order_free || entry == LS_INVALID) return Visit::Descend;
       exact(entry);

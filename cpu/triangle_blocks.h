@@ -155,10 +155,12 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, B
         const lsk::vec3 p2(blk.v[2][0][l], blk.v[2][1][l], blk.v[2][2][l]);
         hits = lsk::ray_triangle(tri_ray, tmin, hit.t, p0, p1, p2, t, u, v);
       } else {
+        float a[3];  // back from the sheared axes (kx, ky, kz) to x, y, z
+        a[tri_ray.kx] = e.a[0][l];
+        a[tri_ray.ky] = e.a[1][l];
+        a[tri_ray.kz] = e.a[2][l];
         lsk::TriEdges edges;
-        edges.a[tri_ray.kx] = e.a[0][l];
-        edges.a[tri_ray.ky] = e.a[1][l];
-        edges.a[tri_ray.kz] = e.a[2][l];
+        edges.a = lsk::vec3(a[0], a[1], a[2]);
         edges.ks = e.ks[l];
         edges.eu = e.eu[l];
         edges.ev = e.ev[l];
