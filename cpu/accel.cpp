@@ -228,8 +228,12 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
   trace_rays(accel, rays, hits, count, any_hit, counters, accel.traversal);
 }
 
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
-                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
+namespace {
+
+// trace_rays and trace_occlusion: TBB over chunks of rays, each chunk on its own copy of the trace
+// context, counters per thread and summed once.
+void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit, bool occlusion,
+                  lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
   const lsk::TraceContext context = accel.context();
   const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
   // Per-thread counters, summed once at the end: no lock on the hot path.
@@ -237,7 +241,9 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
   tbb::enumerable_thread_specific<TraceWorkTotals> per_thread_work;
   ls::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
     lsk::TraceContext local = context;
-    if (fast)
+    if (fast && occlusion)
+      fast->occluded(local, rays + r.begin(), hits + r.begin(), r.size());
+    else if (fast)
       fast->trace(local, rays + r.begin(), hits + r.begin(), r.size(), any_hit);
     else
       for (size_t i = r.begin(); i != r.end(); ++i) hits[i] = trace_ray_counted(local, accel, rays[i], any_hit);
@@ -257,6 +263,22 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
       work->triangle_tests += w.triangle_tests;
       work->lookups += w.lookups;
     }
+}
+
+}  // namespace
+
+void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
+  trace_chunks(accel, rays, hits, count, any_hit, false, counters, traversal, work);
+}
+
+void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
+                     Traversal traversal) {
+  trace_chunks(accel, rays, hits, count, true, true, counters, traversal, nullptr);
+}
+
+void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters) {
+  trace_occlusion(accel, rays, hits, count, counters, accel.traversal);
 }
 
 }  // namespace ls

@@ -89,6 +89,13 @@ struct TraceWorkTotals {
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work = nullptr);
 
+// Occlusion queries (shadow rays) on all threads: a ray misses exactly where trace_rays' any hit
+// misses; where it is blocked its hit record is *a* hit in [tmin, tmax] (on the fast path not
+// necessarily the reference's first: FastTracer::occluded).  The path tracer's shadow rays use it.
+void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters = nullptr);
+void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
+                     Traversal traversal);
+
 void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from);
 
 }  // namespace ls

@@ -42,7 +42,11 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   std::vector<lsk::Hit> hits(rays.size());
   std::vector<std::function<void()>> runs;
   for (const Accel& accel : built) {
-    runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, Traversal::Fast); });
+    // Occlusion queries (rtcOccluded1's kind) on the fast path; the reference keeps its any hit.
+    if (any_hit)
+      runs.push_back([&] { trace_occlusion(accel, rays.data(), hits.data(), rays.size(), nullptr, Traversal::Fast); });
+    else
+      runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), false, nullptr, Traversal::Fast); });
     runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, Traversal::Reference); });
   }
   runs.push_back([&] { embree.trace(rays.data(), hits.data(), rays.size(), any_hit); });

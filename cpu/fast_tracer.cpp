@@ -288,13 +288,13 @@ struct ExactWalk {
   }
 
   // Visits the next wide node or leaf; leaf(child, count) tests a leaf's primitives against the
-  // running hit.  When the boxes admit several children, all of them start loading at once.  False
-  // when the walk is over.
+  // running hit and returns true to end the walk there (an occlusion query's first hit).  When the
+  // boxes admit several children, all of them start loading at once.  False when the walk is over.
   template <bool kParallel, class LeafFn, class PrefetchFn>
   LS_ALWAYS_INLINE bool step(const ExactWideTree& tree, const ExactBoxRay& ray, const Float4& tmin, const Hit& hit,
                              LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
     if (count != 0u) {
-      leaf(child, count);
+      if (leaf(child, count)) return false;  // the query stops at this leaf
       return pop(hit.t);
     }
     const ExactWideNode& node = tree.nodes[child];
@@ -399,10 +399,13 @@ class WideTracer final : public FastTracer {
   const void* object_part() const override { return part_.get(); }
 
   void trace(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, bool any_hit) const override {
-    if (two_level_)
-      for (size_t i = 0; i < count; ++i) hits[i] = trace_two_level(c, rays[i], any_hit);
-    else
-      for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], any_hit);
+    trace_all(c, rays, hits, count, any_hit ? Query::AnyHit : Query::Closest);
+  }
+
+  void occluded(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count) const override {
+    // With a Line Space the ordered walk stays: which lookups run before the first hit is in the
+    // counters, and those must be the reference's.
+    trace_all(c, rays, hits, count, c.ls_enabled != 0u ? Query::AnyHit : Query::Occlusion);
   }
 
   uint32_t find_candidate(lsk::TraceContext& c, const lsk::LsNode& ls, uint32_t shaft, uint32_t further_rays,
@@ -413,7 +416,7 @@ class WideTracer final : public FastTracer {
       if (!c.ls_search_segment(ls, shaft, k, a, d)) continue;
       Hit hit = c.ls_search_hit();
       uint prim = LS_INVALID;
-      trace_bvh(c, ls.node, a, d, 0.0f, instance, false, false, hit, prim);
+      trace_bvh(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
       if (prim != LS_INVALID) return prim;
     }
     return LS_INVALID;
@@ -432,12 +435,25 @@ class WideTracer final : public FastTracer {
     top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
   }
 
+  // What a trace asks: the closest hit, the reference's any hit (the first in its order), or only
+  // whether anything is hit (some hit, found in any order: the fast path's shadow rays).
+  enum class Query { Closest, AnyHit, Occlusion };
+
+  void trace_all(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query q) const {
+    if (two_level_)
+      for (size_t i = 0; i < count; ++i) hits[i] = trace_two_level(c, rays[i], q);
+    else
+      for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], q);
+  }
+
   // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
-  // the order-free walk below the entries it reaches, for closest-hit queries.
-  bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, uint instance,
-                 bool any_hit, bool use_ls, Hit& hit, uint& hit_prim) const {
+  // the order-free walk below the entries it reaches, except for the reference's any hit.  Returns
+  // true when an any-hit or occlusion query found its hit (the caller stops).
+  bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, uint instance, Query q,
+                 bool use_ls, Hit& hit, uint& hit_prim) const {
+    const bool any_hit = q != Query::Closest;
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
-    const bool order_free = !any_hit && order_free_ray(origin, dir, tmin);
+    const bool order_free = q != Query::AnyHit && order_free_ray(origin, dir, tmin);
     // Made when first needed: many rays that enter an instance's box never reach a triangle of it.
     lsk::TriRay tri_ray_made;
     bool tri_ray_ready = false;
@@ -450,15 +466,18 @@ class WideTracer final : public FastTracer {
     };
     ExactBoxRay exact_ray;  // made once, at the first order-free walk
     bool exact_ray_made = false;
-    auto exact = [&](uint entry) {
+    auto exact = [&](uint entry) {  // true: an occlusion query's hit
       if (!exact_ray_made) {
         exact_ray = make_slab_ray<Float4, ExactWideNode>(origin, inv_dir, true);
         exact_ray_made = true;
       }
+      bool stopped = false;
       auto run = [&](auto&& ray_for_leaf) {
         walk_exact(
             part_->exact, entry, exact_ray, tmin, hit,
-            [&](uint lane, uint n) { trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, false, hit, hit_prim); },
+            [&](uint lane, uint n) {
+              return stopped = trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, any_hit, hit, hit_prim);
+            },
             [&](uint lane) { prefetch_block(lane / 4u); });
       };
       if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
@@ -467,14 +486,12 @@ class WideTracer final : public FastTracer {
       } else {  // an instance's object: many walks end before any leaf
         run(tri_ray);
       }
+      return stopped;
     };
     const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
     const uint root_entry = part_->exact.entry_of[root];
-    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID) {
-      // The entry's wide node tests the root's children, which pass only where the root's box would.
-      exact(root_entry);
-      return false;
-    }
+    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID)
+      return exact(root_entry);  // the entry's node tests the root's children, which pass only where the root would
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
     auto visit = [&](uint ls, bool leaf, uint, uint count, uint tri_lane, uint entry) {
@@ -487,8 +504,7 @@ class WideTracer final : public FastTracer {
         return trace_blocks(c, blocks_, tri_lane, count, tri_ray(), tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
                                                                                                         : Visit::Skip;
       if (!order_free || entry == LS_INVALID) return Visit::Descend;
-      exact(entry);
-      return Visit::Skip;
+      return exact(entry) ? Visit::Stop : Visit::Skip;
     };
     const lsk::BvhNode& node = c.nodes[root];
     if (node.count > 0)  // a root that is a leaf has no wide node
@@ -499,14 +515,14 @@ class WideTracer final : public FastTracer {
                 make_slab_ray<FloatBatch, WideNode<K>>(origin, inv_dir, order_free_ray(origin, dir, tmin)), tmin, hit, visit);
   }
 
-  Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
+  Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, Query q) const {
     Hit hit = lsk::empty_hit(ray);
     uint prim = LS_INVALID;
-    trace_bvh(c, 0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, any_hit, c.ls_enabled != 0u, hit, prim);
+    trace_bvh(c, 0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, q, c.ls_enabled != 0u, hit, prim);
     return lsk::finish_hit(hit);
   }
 
-  Hit trace_two_level(lsk::TraceContext& c, const lsk::Ray& ray, bool any_hit) const {
+  Hit trace_two_level(lsk::TraceContext& c, const lsk::Ray& ray, Query q) const {
     Hit hit = lsk::empty_hit(ray);
     uint prim = LS_INVALID;
     const vec3 inv_dir = lsk::safe_reciprocal(ray.dir);
@@ -514,23 +530,22 @@ class WideTracer final : public FastTracer {
     if (!lsk::ray_box(ray.origin, inv_dir, ray.tmin, hit.t, c.top_nodes[0].lo, c.top_nodes[0].hi, t_root))
       return lsk::finish_hit(hit);
     const bool use_ls = c.ls_enabled != 0u;
-    auto instances = [&](uint first, uint count) {
+    auto instances = [&](uint first, uint count) {  // true: the query stops
       for (uint i = first; i < first + count; ++i) {
         const lsk::InstanceRecord& rec = c.instances[i];
         vec3 o;
         vec3 d;
         c.instance_ray(rec, ray.origin, ray.dir, o, d);
-        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, any_hit, use_ls, hit, prim)) return true;
+        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, q, use_ls, hit, prim)) return true;
       }
       return false;
     };
     const lsk::BvhNode& root = c.top_nodes[0];
     if (root.count > 0)
       instances(root.first, root.count);
-    else if (!any_hit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no Line Space decision depends on the order
+    else if (q != Query::AnyHit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no decision depends on the order
       walk_exact(top_exact_, top_exact_.entry_of[0], make_slab_ray<Float4, ExactWideNode>(ray.origin, inv_dir, true), ray.tmin,
-                 hit, instances,
-                 [](uint) {});
+                 hit, instances, [](uint) {});
     else
       walk(top_, top_.wide_of[0],
            make_slab_ray<FloatBatch, WideNode<K>>(ray.origin, inv_dir, order_free_ray(ray.origin, ray.dir, ray.tmin)),

@@ -28,6 +28,11 @@ class FastTracer {
   // this tracer was made for); Line Space counters are added to context.ls_counters.
   virtual void trace(lsk::TraceContext& context, const lsk::Ray* rays, lsk::Hit* hits, size_t count,
                      bool any_hit) const = 0;
+  // Occlusion queries (shadow rays): hits[i] misses exactly where the reference's any hit misses;
+  // where something is hit it holds *a* hit in [tmin, tmax], not necessarily the one the reference's
+  // order finds first, since the exact structures are walked order-free here.  Structures with a
+  // Line Space answer as trace(..., any_hit = true) does (their counters depend on the order).
+  virtual void occluded(lsk::TraceContext& context, const lsk::Ray* rays, lsk::Hit* hits, size_t count) const = 0;
   // lsk::TraceContext::ls_find_candidate on the fast path, the same candidate bit for bit: each
   // search segment is a closest-hit query in the LS node's own subtree, which the order-free walk
   // answers (the node is an entry of the exact wide tree).

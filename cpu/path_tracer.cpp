@@ -165,11 +165,15 @@ std::vector<StructureSpec> render_structures(const RenderOptions& options) {
 
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
                     const Progress& progress, const BatchTracer& tracer) {
-  // The first trace_rays overload: each structure's own traversal (accel.traversal).
+  // Each structure's own traversal (accel.traversal); shadow rays (any hit) are occlusion queries,
+  // of which the render reads only whether they are blocked.
   const BatchTracer trace_batch =
       tracer ? tracer
              : BatchTracer([](const Accel& a, const lsk::Ray* r, lsk::Hit* h, size_t n, bool any, lsk::LsCounters* c) {
-                 trace_rays(a, r, h, n, any, c);
+                 if (any)
+                   trace_occlusion(a, r, h, n, c);
+                 else
+                   trace_rays(a, r, h, n, any, c);
                });
   const auto start = std::chrono::steady_clock::now();
   const uint32_t pixels = options.width * options.height;

@@ -77,7 +77,8 @@ struct RenderResult {
 // progress(done, total) is called after every pass (one sample per pixel).
 using Progress = std::function<void(int done, int total)>;
 
-// Traces one batch of rays with a structure, like trace_rays(); the GPU port passes its own.
+// Traces one batch of rays with a structure, like trace_rays() (any_hit: the shadow rays, of which
+// only whether they are blocked is read); the GPU port passes its own.
 using BatchTracer = std::function<void(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                                        lsk::LsCounters* counters)>;
 
@@ -101,7 +102,8 @@ void average_passes(RenderResult& result, int spp);
 
 // structures: built structures keyed by canonical name; every schedule entry (and the throughput
 // switch's structure, when it is on) must be present.
-// tracer: where the batches are traced (empty: trace_rays on all CPU threads).
+// tracer: where the batches are traced (empty: trace_rays, and trace_occlusion for shadow rays, on
+// all CPU threads).
 RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,
                     const Progress& progress = {}, const BatchTracer& tracer = {});
 

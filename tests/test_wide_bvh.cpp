@@ -459,3 +459,70 @@ TEST_CASE("wide BVH: the candidate search on the fast path stores the reference 
         CHECK(found > 0);
       }
 }
+
+TEST_CASE("wide BVH: occlusion queries miss exactly where the reference's any hit misses, and report a real hit", "[wide]") {
+  auto check = [](const ls::Accel& a, const std::vector<lsk::Ray>& rays, const std::string& what) {
+    INFO(what << ", " << a.spec.name());
+    std::vector<lsk::Hit> ref(rays.size()), occ(rays.size());
+    lsk::LsCounters ref_counters{}, occ_counters{};
+    ls::trace_rays(a, rays.data(), ref.data(), rays.size(), true, &ref_counters, ls::Traversal::Reference);
+    ls::trace_occlusion(a, rays.data(), occ.data(), rays.size(), &occ_counters, ls::Traversal::Fast);
+    size_t blocked = 0, wrong_blocking = 0, unverified = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      const bool ref_blocked = ref[i].triangle != lsk::LS_INVALID;
+      wrong_blocking += ref_blocked != (occ[i].triangle != lsk::LS_INVALID);
+      if (!ref_blocked || occ[i].triangle == lsk::LS_INVALID) continue;
+      ++blocked;
+      if (a.spec.line_space()) {  // the ordered walk: the reference's record itself
+        unverified += std::memcmp(&ref[i], &occ[i], sizeof(lsk::Hit)) != 0;
+        continue;
+      }
+      // The reported triangle is hit by the kernel at the reported t, inside the ray's interval.
+      size_t k = 0;
+      while (k < a.tri_ids.size() && !(a.tri_ids[k] == occ[i].triangle &&
+                                       (a.spec.two_level() || a.tri_instances[k] == occ[i].instance)))
+        ++k;
+      glm::vec3 o = rays[i].origin, d = rays[i].dir;
+      if (a.spec.two_level()) {
+        bool found = false;
+        for (const lsk::InstanceRecord& rec : a.instances)
+          if (rec.instance == occ[i].instance) {
+            lsk::TraceContext c = a.context();
+            c.instance_ray(rec, rays[i].origin, rays[i].dir, o, d);
+            // the object's triangles: those in the subtree of rec.root with this id
+            for (k = 0; k < a.tri_ids.size(); ++k) {
+              if (a.tri_ids[k] != occ[i].triangle) continue;
+              float t, u, v;
+              if (lsk::ray_triangle(lsk::make_tri_ray(o, d), rays[i].tmin, rays[i].tmax, glm::vec3(a.tris[k].v0),
+                                    glm::vec3(a.tris[k].v1), glm::vec3(a.tris[k].v2), t, u, v) &&
+                  t == occ[i].t)
+                found = true;
+            }
+          }
+        unverified += !found;
+        continue;
+      }
+      float t, u, v;
+      const bool hit = k < a.tris.size() && lsk::ray_triangle(lsk::make_tri_ray(o, d), rays[i].tmin, rays[i].tmax,
+                                                               glm::vec3(a.tris[k].v0), glm::vec3(a.tris[k].v1),
+                                                               glm::vec3(a.tris[k].v2), t, u, v);
+      unverified += !(hit && t == occ[i].t && u == occ[i].u && v == occ[i].v);
+    }
+    CHECK(wrong_blocking == 0);
+    CHECK(unverified == 0);
+    CHECK(blocked > 0);
+    if (a.spec.line_space()) CHECK(std::memcmp(&ref_counters, &occ_counters, sizeof(lsk::LsCounters)) == 0);
+  };
+  const ls::Scene cornell = ls::load_scene("builtin:cornell");
+  const ls::Scene random = random_scene(10);
+  for (const ls::Scene* scene : {&cornell, &random}) {
+    const ls::Accel exact = ls::build_accel(*scene, ls::parse_structure("bvh"));
+    const std::vector<lsk::Ray> shadow = ls::generate_rays(*scene, exact, ls::RayKind::Shadow, 3000, 21);
+    const std::vector<lsk::Ray> diffuse = ls::generate_rays(*scene, exact, ls::RayKind::Diffuse, 3000, 22);
+    for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
+      const ls::Accel a = ls::build_accel(*scene, ls::parse_structure(s), options(4));
+      check(a, shadow, scene->name + ", shadow rays");
+      check(a, diffuse, scene->name + ", diffuse rays");
+    }
+  }
+}
