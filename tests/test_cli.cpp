@@ -146,6 +146,27 @@ TEST_CASE("rays, trace and build agree with the file formats and JSON keys", "[c
       CHECK(o.contains(key));
 }
 
+TEST_CASE("bench prints DESIGN 9's JSON keys for each structure and Embree, closest hit and occlusion", "[cli]") {
+  for (const char* kind : {"diffuse", "shadow"}) {
+    const Run r = run(std::string("bench --scene builtin:cornell --count 2000 --repeat 1 --structures 2l-bvh,f-ls:3:3 --json --kind ") + kind);
+    REQUIRE(r.status == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["rays"].get<size_t>() == 2000u);
+    CHECK(j["any_hit"].get<bool>() == (std::string(kind) == "shadow"));
+    REQUIRE(j["results"].size() == 3u);
+    for (const auto& e : j["results"]) {
+      for (const char* key : {"structure", "mrays_per_s", "ratio_vs_embree", "bytes"}) CHECK(e.contains(key));
+      CHECK(e["mrays_per_s"].get<double>() > 0.0);
+      if (e["structure"] != "embree") {
+        CHECK(e["reference_mrays_per_s"].get<double>() > 0.0);
+        CHECK(e["ratio_vs_fast_bvh"].is_null());  // no bvh in this run
+      }
+    }
+    CHECK(j["results"][2]["structure"] == "embree");
+    CHECK(j["results"][2]["ratio_vs_embree"].get<double>() == 1.0);
+  }
+}
+
 TEST_CASE("render writes every image and a report", "[cli]") {
   const fs::path out = temp("render");
   fs::remove_all(out);
