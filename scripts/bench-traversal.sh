@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Traversal speed beside Embree 3 on the same rays: per scene and structure, the fast path's MRays/s,
+# its ratio to Embree's rtcIntersect1 (rtcOccluded1 for KIND=shadow) measured in the same run, and its
+# ratio to our scalar reference path; medians over RUNS runs of `linespace-cpu bench` (each run
+# itself the median of REPEAT timings, all threads).
+#   scripts/bench-traversal.sh [SCENE ...]    default: the built-in scenes and assets/real/*.glb
+#   RUNS=3 REPEAT=3 COUNT=200000 KIND=diffuse STRUCTURES=bvh,2l-bvh,f-ls:8:6,2l-ls:4:6
+#   LS_FLAGS="--ls-min-triangles 0"           Line Space flags for every run (the paper's setting)
+#   LINESPACE_CPU=build/release/cpu/linespace-cpu
+# Prints a Markdown table.  docs/performance.md, "Measurements".
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BIN=${LINESPACE_CPU:-build/release/cpu/linespace-cpu}
+RUNS=${RUNS:-3}
+REPEAT=${REPEAT:-3}
+COUNT=${COUNT:-200000}
+KIND=${KIND:-diffuse}
+STRUCTURES=${STRUCTURES:-bvh,2l-bvh,f-ls:8:6,2l-ls:4:6}
+LS_FLAGS=${LS_FLAGS---ls-min-triangles 0}
+[[ -x $BIN ]] || { echo "bench-traversal: $BIN is not built (scripts/run-demo.sh builds it)" >&2; exit 2; }
+[[ $RUNS =~ ^[1-9][0-9]*$ ]] || { echo "bench-traversal: RUNS=$RUNS is not a positive integer" >&2; exit 2; }
+scenes=("$@")
+if [[ ${#scenes[@]} -eq 0 ]]; then
+  scenes=(builtin:cornell builtin:generated:143000:49:1 builtin:instances)
+  for f in assets/real/*.glb; do [[ -e $f ]] && scenes+=("$f"); done
+fi
+
+echo "| scene | structure | fast MRays/s | vs Embree | fast / reference | Embree MRays/s |"
+echo "|---|---|---:|---:|---:|---:|"
+for scene in "${scenes[@]}"; do
+  tmp=$(mktemp)
+  for ((run = 1; run <= RUNS; ++run)); do
+    echo "  $scene: run $run of $RUNS" >&2
+    # shellcheck disable=SC2086  # LS_FLAGS is a list of flags
+    "$BIN" bench --scene "$scene" --kind "$KIND" --count "$COUNT" --repeat "$REPEAT" --structures "$STRUCTURES" \
+      $LS_FLAGS --json >> "$tmp"
+    echo >> "$tmp"
+  done
+  python3 - "$scene" "$tmp" <<'EOF'
+import json, statistics, sys
+scene, path = sys.argv[1], sys.argv[2]
+runs, text = [], open(path).read()
+decoder, at = json.JSONDecoder(), 0
+while True:
+    while at < len(text) and text[at].isspace():
+        at += 1
+    if at >= len(text):
+        break
+    run, at = decoder.raw_decode(text, at)
+    runs.append(run)
+embree = statistics.median(next(e["mrays_per_s"] for e in r["results"] if e["structure"] == "embree") for r in runs)
+for name in [e["structure"] for e in runs[0]["results"] if e["structure"] != "embree"]:
+    entries = [next(e for e in r["results"] if e["structure"] == name) for r in runs]
+    fast = statistics.median(e["mrays_per_s"] for e in entries)
+    ratio = statistics.median(e["ratio_vs_embree"] for e in entries)
+    vs_ref = statistics.median(e["mrays_per_s"] / e["reference_mrays_per_s"] for e in entries)
+    print(f"| {scene} | {name} | {fast:.2f} | {ratio:.2f}x | {vs_ref:.2f}x | {embree:.2f} |")
+EOF
+  rm -f "$tmp"
+done
