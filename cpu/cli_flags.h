@@ -52,7 +52,7 @@ struct LsFlags {
   void add_to(CLI::App* app) {
     app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
         ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
-    app->add_option("--wide-width", wide_width, "children per node of the fast path's wide BVH")
+    app->add_option("--wide-width", wide_width, "treelet width of the fast path's ordered walk (Line Space structures): 4 or 8")
         ->capture_default_str()->check(CLI::IsMember({4, 8}));
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));

@@ -373,14 +373,17 @@ struct ObjectPart {
 template <int K>
 class WideTracer final : public FastTracer {
  public:
-  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()) {
+  // Only Line Space structures get treelets (their lookups need the reference's order).  An exact
+  // structure answers everything order-free but the reference's any hit (trace --any-hit), which
+  // its reference kernels answer; shadow rays are occlusion queries (occluded()).
+  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()), ordered_(accel.spec.line_space()) {
     const std::vector<uint32_t> none;
     const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
     auto part = std::make_shared<ObjectPart<K>>();
     const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
     part->exact = build_exact_wide_tree(accel.nodes, node_ls, roots);
     part->blocks = build_triangle_blocks(accel.nodes, accel.tris, part->exact);
-    part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.lane_of, part->exact.entry_of);
+    if (ordered_) part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.lane_of, part->exact.entry_of);
     if (two_level_) build_top(accel);
     part_ = std::move(part);
     blocks_ = part_->blocks.blocks.data();
@@ -388,7 +391,7 @@ class WideTracer final : public FastTracer {
 
   // The object part of `other`, new wide top trees over accel.top_nodes.
   WideTracer(const WideTracer& other, const Accel& accel)
-      : two_level_(other.two_level_), part_(other.part_), blocks_(other.blocks_) {
+      : two_level_(other.two_level_), ordered_(other.ordered_), part_(other.part_), blocks_(other.blocks_) {
     build_top(accel);
   }
 
@@ -428,11 +431,11 @@ class WideTracer final : public FastTracer {
   int width() const override { return 1 << K; }
 
  private:
-  // The top level: treelets (ordered: Line Space structures and any hit) and the exact wide tree,
-  // whose leaf lanes hold their first instance.
+  // The top level: the exact wide tree, whose leaf lanes hold their first instance, and for Line
+  // Space structures the treelets.
   void build_top(const Accel& accel) {
     top_exact_ = build_exact_wide_tree(accel.top_nodes, {}, {0u});
-    top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
+    if (ordered_) top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
   }
 
   // What a trace asks: the closest hit, the reference's any hit (the first in its order), or only
@@ -440,10 +443,13 @@ class WideTracer final : public FastTracer {
   enum class Query { Closest, AnyHit, Occlusion };
 
   void trace_all(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query q) const {
-    if (two_level_)
-      for (size_t i = 0; i < count; ++i) hits[i] = trace_two_level(c, rays[i], q);
-    else
-      for (size_t i = 0; i < count; ++i) hits[i] = trace_flat(c, rays[i], q);
+    for (size_t i = 0; i < count; ++i) {
+      const lsk::Ray& ray = rays[i];
+      if (!ordered_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
+        hits[i] = two_level_ ? c.trace_two_level(ray, q != Query::Closest) : c.trace_flat(ray, q != Query::Closest);
+      else
+        hits[i] = two_level_ ? trace_two_level(c, ray, q) : trace_flat(c, ray, q);
+    }
   }
 
   // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
@@ -452,8 +458,10 @@ class WideTracer final : public FastTracer {
   bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, uint instance, Query q,
                  bool use_ls, Hit& hit, uint& hit_prim) const {
     const bool any_hit = q != Query::Closest;
-    const vec3 inv_dir = lsk::safe_reciprocal(dir);
     const bool order_free = q != Query::AnyHit && order_free_ray(origin, dir, tmin);
+    if (!order_free && !ordered_)  // no treelets: the reference kernel (e.g. an object ray that overflowed)
+      return c.trace_bvh(root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
+    const vec3 inv_dir = lsk::safe_reciprocal(dir);
     // Made when first needed: many rays that enter an instance's box never reach a triangle of it.
     lsk::TriRay tri_ray_made;
     bool tri_ray_ready = false;
@@ -563,6 +571,7 @@ class WideTracer final : public FastTracer {
   }
 
   bool two_level_;
+  bool ordered_;  // a Line Space structure: treelets for the reference's order
   std::shared_ptr<const ObjectPart<K>> part_;
   const TriBlock* blocks_ = nullptr;  // part_->blocks.blocks.data(): one load less on the hot path
   WideTree<K> top_;
