@@ -203,8 +203,17 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
   return accel;
 }
 
+lsk::Hit trace_ray_reference(lsk::TraceContext& context, const lsk::Ray& ray, bool two_level, bool any_hit) {
+  return two_level ? context.trace_two_level(ray, any_hit) : context.trace_flat(ray, any_hit);
+}
+
+bool trace_bvh_reference(lsk::TraceContext& context, uint32_t root, const lsk::vec3& origin, const lsk::vec3& dir,
+                         float tmin, uint32_t instance, bool any_hit, bool use_ls, lsk::Hit& hit, uint32_t& hit_prim) {
+  return context.trace_bvh(root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
+}
+
 lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit) {
-  return accel.spec.two_level() ? context.trace_two_level(ray, any_hit) : context.trace_flat(ray, any_hit);
+  return trace_ray_reference(context, ray, accel.spec.two_level(), any_hit);
 }
 
 lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit) {

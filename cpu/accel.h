@@ -76,6 +76,13 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
 lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 
+// The reference kernels on one ray (flat or two-level) and on one BVH (an object-space ray), for the
+// fast path's fallbacks (fast_tracer.h).  Compiled here, not in fast_tracer.cpp: the kernels
+// instantiated there took GCC's inlining budget from the fast walks (5 % more instructions a ray).
+lsk::Hit trace_ray_reference(lsk::TraceContext& context, const lsk::Ray& ray, bool two_level, bool any_hit);
+bool trace_bvh_reference(lsk::TraceContext& context, uint32_t root, const lsk::vec3& origin, const lsk::vec3& dir,
+                         float tmin, uint32_t instance, bool any_hit, bool use_ls, lsk::Hit& hit, uint32_t& hit_prim);
+
 // Traces a batch on all threads (TBB) with accel.traversal; Line Space counters are added to *counters
 // when given.  The second form names the traversal (bench and tests run both on one structure).
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,

@@ -446,7 +446,7 @@ class WideTracer final : public FastTracer {
     for (size_t i = 0; i < count; ++i) {
       const lsk::Ray& ray = rays[i];
       if (!ordered_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
-        hits[i] = two_level_ ? c.trace_two_level(ray, q != Query::Closest) : c.trace_flat(ray, q != Query::Closest);
+        hits[i] = trace_ray_reference(c, ray, two_level_, q != Query::Closest);
       else
         hits[i] = two_level_ ? trace_two_level(c, ray, q) : trace_flat(c, ray, q);
     }
@@ -460,7 +460,7 @@ class WideTracer final : public FastTracer {
     const bool any_hit = q != Query::Closest;
     const bool order_free = q != Query::AnyHit && order_free_ray(origin, dir, tmin);
     if (!order_free && !ordered_)  // no treelets: the reference kernel (e.g. an object ray that overflowed)
-      return c.trace_bvh(root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
+      return trace_bvh_reference(c, root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
     // Made when first needed: many rays that enter an instance's box never reach a triangle of it.
     lsk::TriRay tri_ray_made;

@@ -1,8 +1,13 @@
-// The fast CPU path: traversal of the wide BVH (wide_bvh.h) with SIMD box tests (xsimd), beside the
-// scalar single-source reference (common/kernels/traverse_bvh.h).  It gives the reference's answers
-// bit for bit: the same box arithmetic lane by lane, the same visiting order, and the very same
-// shared kernels for triangles (trace_leaf), instances (instance_ray) and Line Space lookups
-// (ls_lookup), so hits, t, u, v and the Line Space counters are identical.
+// The fast CPU path beside the scalar single-source reference (common/kernels/traverse_bvh.h), with
+// SIMD box and triangle tests (xsimd).  It gives the reference's answers bit for bit, by two walks:
+//  - closest-hit queries below any node with no Line Space under it walk an order-free 4-wide BVH
+//    (exact_wide_bvh.h), since the closest hit does not depend on the visiting order;
+//  - Line Space structures walk treelets (wide_bvh.h) in the reference's own order, since a lookup's
+//    answer does, and call the shared kernels (ls_lookup, instance_ray) at the same moments.
+// Triangles are tested four at a time (triangle_blocks.h) with the kernel's arithmetic, so hits, t, u,
+// v and the Line Space counters are identical.  Any-hit queries on exact structures take the
+// reference kernels (the triangle they report depends on the order); occlusion queries, which only
+// ask whether something is hit, take the order-free walk.
 #pragma once
 
 #include "trace_context.h"
