@@ -42,7 +42,7 @@ using lsk::vec3;
 
 // Rays the order-free walk takes: finite origin, direction and tmin (its slab arithmetic is the
 // reference's only there; anything else follows the reference's order in the treelets).
-bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
+LS_ALWAYS_INLINE bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
   return std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z) && std::isfinite(dir.x) &&
          std::isfinite(dir.y) && std::isfinite(dir.z) && !std::isnan(tmin);
 }
@@ -63,21 +63,29 @@ struct SlabRay {
 };
 
 template <class Batch, class Node>
-SlabRay<Batch> make_slab_ray(const vec3& origin, const vec3& inv_dir, bool finite) {
+void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const vec3& inv_dir, bool finite) {
   constexpr float big = 3.0e38f;
   constexpr uint32_t row = uint32_t(sizeof(Node::lo[0]));
-  SlabRay<Batch> r;
+  const float o[3] = {origin.x, origin.y, origin.z};  // indexed in memory, not through glm's switch
+  const float inv[3] = {inv_dir.x, inv_dir.y, inv_dir.z};
   for (int a = 0; a < 3; ++a) {
-    r.origin[a] = Batch(origin[a]);
-    r.inv_dir[a] = Batch(inv_dir[a]);
+    r.origin[a] = Batch(o[a]);
+    r.inv_dir[a] = Batch(inv[a]);
     r.lo[a] = uint32_t(offsetof(Node, lo)) + row * uint32_t(a);
     r.hi[a] = uint32_t(offsetof(Node, hi)) + row * uint32_t(a);
-    r.enter[a] = inv_dir[a] >= 0.0f ? r.lo[a] : r.hi[a];
-    r.leave[a] = inv_dir[a] >= 0.0f ? r.hi[a] : r.lo[a];
-    r.parallel[a] = std::abs(inv_dir[a]) == big;
+    const bool ascending = inv[a] >= 0.0f;
+    r.enter[a] = ascending ? r.lo[a] : r.hi[a];
+    r.leave[a] = ascending ? r.hi[a] : r.lo[a];
+    r.parallel[a] = std::abs(inv[a]) == big;
   }
   r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
   r.by_sign = finite;
+}
+
+template <class Batch, class Node>
+SlabRay<Batch> make_slab_ray(const vec3& origin, const vec3& inv_dir, bool finite) {
+  SlabRay<Batch> r;
+  init_slab_ray<Batch, Node>(r, origin, inv_dir, finite);
   return r;
 }
 
@@ -128,7 +136,7 @@ LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, cons
 
 // The box tests of every lane of a treelet: entry distances and widened exit distances.
 template <int K>
-inline void box_tests(const WideNode<K>& node, const SlabRay<FloatBatch>& r, const FloatBatch& tmin, float tmax, float* tnear,
+LS_ALWAYS_INLINE void box_tests(const WideNode<K>& node, const SlabRay<FloatBatch>& r, const FloatBatch& tmin, float tmax, float* tnear,
                       float* tfar) {
   const FloatBatch tmax_batch(tmax);
   for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
@@ -445,8 +453,9 @@ class WideTracer final : public FastTracer {
   void trace_all(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query q) const {
     for (size_t i = 0; i < count; ++i) {
       const lsk::Ray& ray = rays[i];
-      if (!ordered_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
-        hits[i] = trace_ray_reference(c, ray, two_level_, q != Query::Closest);
+      // A flat structure's trace_bvh makes this choice itself; the top walk of a two-level one does not.
+      if (two_level_ && !ordered_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
+        hits[i] = trace_ray_reference(c, ray, true, q != Query::Closest);
       else
         hits[i] = two_level_ ? trace_two_level(c, ray, q) : trace_flat(c, ray, q);
     }
@@ -463,20 +472,24 @@ class WideTracer final : public FastTracer {
       return trace_bvh_reference(c, root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
     // Made when first needed: many rays that enter an instance's box never reach a triangle of it.
-    lsk::TriRay tri_ray_made;
+    BlockRay tri_ray_made;
     bool tri_ray_ready = false;
-    auto tri_ray = [&]() -> const lsk::TriRay& {
+    auto tri_ray = [&]() LS_ALWAYS_LAMBDA -> const BlockRay& {
       if (!tri_ray_ready) {
-        tri_ray_made = lsk::make_tri_ray(origin, dir);
+        tri_ray_made.tri = lsk::make_tri_ray(origin, dir);
+        broadcast_block_ray(tri_ray_made);
         tri_ray_ready = true;
       }
       return tri_ray_made;
     };
     ExactBoxRay exact_ray;  // made once, at the first order-free walk
     bool exact_ray_made = false;
-    auto exact = [&](uint entry) {  // true: an occlusion query's hit
+    // Inlined where an exact structure or an instance's object starts with it (2l-bvh on cornell
+    // 3,781 -> 3,611 instructions a ray); a call from the treelet walk, which inlined it there
+    // outgrew GCC's budget (f-ls:8:6 on cornell 2,818 -> 3,045).
+    auto exact = [&](uint entry) LS_ALWAYS_LAMBDA {  // true: an occlusion query's hit
       if (!exact_ray_made) {
-        exact_ray = make_slab_ray<Float4, ExactWideNode>(origin, inv_dir, true);
+        init_slab_ray<Float4, ExactWideNode>(exact_ray, origin, inv_dir, true);  // in place: no copy
         exact_ray_made = true;
       }
       bool stopped = false;
@@ -489,13 +502,14 @@ class WideTracer final : public FastTracer {
             [&](uint lane) { prefetch_block(lane / 4u); });
       };
       if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
-        const lsk::TriRay& tr = tri_ray();
-        run([&]() -> const lsk::TriRay& { return tr; });
+        const BlockRay& tr = tri_ray();
+        run([&]() -> const BlockRay& { return tr; });
       } else {  // an instance's object: many walks end before any leaf
         run(tri_ray);
       }
       return stopped;
     };
+    auto exact_call = [&](uint entry) __attribute__((noinline)) { return exact(entry); };
     const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
     const uint root_entry = part_->exact.entry_of[root];
     if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID)
@@ -512,7 +526,7 @@ class WideTracer final : public FastTracer {
         return trace_blocks(c, blocks_, tri_lane, count, tri_ray(), tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
                                                                                                         : Visit::Skip;
       if (!order_free || entry == LS_INVALID) return Visit::Descend;
-      return exact(entry) ? Visit::Stop : Visit::Skip;
+      return exact_call(entry) ? Visit::Stop : Visit::Skip;
     };
     const lsk::BvhNode& node = c.nodes[root];
     if (node.count > 0)  // a root that is a leaf has no wide node

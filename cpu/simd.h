@@ -7,6 +7,7 @@
 // The hot path's helpers are inlined whatever the compiler's budget says: out of line, their SIMD
 // values go through memory at every call (the ray-stream loop exceeded GCC's budget).
 #define LS_ALWAYS_INLINE inline __attribute__((always_inline))
+#define LS_ALWAYS_LAMBDA __attribute__((always_inline))  // after a lambda's parameter list
 
 namespace ls {
 

@@ -71,21 +71,40 @@ struct BlockEdges {
   unsigned finish = 0;
 };
 
+// The ray as block_edges reads it, made once per ray from its TriRay: the origin and the shear
+// broadcast into lanes, the origin in the sheared axes' order (kx, ky, kz).
+struct BlockRay {
+  lsk::TriRay tri;
+  Float4 origin[3];  // origin component of sheared axis a, in every lane
+  Float4 shear_x;
+  Float4 shear_y;
+  uint32_t axis[3];  // kx, ky, kz
+};
+
+// Sets b from b.tri.
+LS_ALWAYS_INLINE void broadcast_block_ray(BlockRay& b) {
+  const lsk::TriRay& r = b.tri;
+  b.axis[0] = r.kx;
+  b.axis[1] = r.ky;
+  b.axis[2] = r.kz;
+  const float origin[3] = {r.origin.x, r.origin.y, r.origin.z};  // indexed in memory, not through glm's switch
+  for (int a = 0; a < 3; ++a) b.origin[a] = Float4(origin[b.axis[a]]);
+  b.shear_x = Float4(r.sx);
+  b.shear_y = Float4(r.sy);
+}
+
 // The vertices are read in the ray's axis order (kx, ky, kz) straight from the block, so no axis is
 // picked from registers at run time.  The maximum over the nine coordinates does not depend on that
 // order (max is exact); only a NaN could make it, and a NaN coordinate rejects the lane whatever
 // the scale (its edge functions and t are NaN), as it does in the kernel.
-LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, BlockEdges& out) {
+LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, BlockEdges& out) {
   using namespace block_lanes;
-  const uint32_t axis[3] = {r.kx, r.ky, r.kz};
-  const float origin[3] = {r.origin.x, r.origin.y, r.origin.z};  // indexed in memory, not through glm's switch
   const Float4 magnitude = xsimd::bitwise_cast<Float4>(Int4(0x7FFFFFFF));  // |x| = x & magnitude
   Float4 d[3][3];  // translated vertices: d[vertex][sheared axis]
   Float4 abs_d[3][3];
   for (int a = 0; a < 3; ++a) {
-    const Float4 o(origin[axis[a]]);
     for (int k = 0; k < 3; ++k) {
-      d[k][a] = Float4::load_aligned(block.v[k][axis[a]]) - o;
+      d[k][a] = Float4::load_aligned(block.v[k][r.axis[a]]) - r.origin[a];
       abs_d[k][a] = d[k][a] & magnitude;
     }
   }
@@ -108,11 +127,9 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, B
   for (int a = 0; a < 3; ++a) p[0][a].store_aligned(out.a[a]);
   Float4 sx[3];
   Float4 sy[3];
-  const Float4 shear_x(r.sx);
-  const Float4 shear_y(r.sy);
   for (int k = 0; k < 3; ++k) {
-    sx[k] = p[k][0] - shear_x * p[k][2];
-    sy[k] = p[k][1] - shear_y * p[k][2];
+    sx[k] = p[k][0] - r.shear_x * p[k][2];
+    sy[k] = p[k][1] - r.shear_y * p[k][2];
   }
   const Float4 eu = sx[2] * sy[1] - sy[2] * sx[1];
   const Float4 ev = sx[0] * sy[2] - sy[0] * sx[2];
@@ -134,12 +151,13 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const lsk::TriRay& r, B
 // and offered in that order.  Returns true when any_hit is set and a hit was found (the caller
 // stops).  Flattened: the kernel's halves are inlined into it.
 [[gnu::flatten]] inline bool trace_blocks(const lsk::TraceContext& c, const TriBlock* blocks, uint32_t lane, uint32_t count,
-                                          const lsk::TriRay& tri_ray, float tmin, uint32_t instance, bool any_hit,
+                                          const BlockRay& block_ray, float tmin, uint32_t instance, bool any_hit,
                                           lsk::Hit& hit, uint32_t& hit_prim) {
+  const lsk::TriRay& tri_ray = block_ray.tri;
   BlockEdges e;
   for (uint32_t at = lane, end = lane + count; at < end; at = (at | 3u) + 1u) {
     const TriBlock& blk = blocks[at / 4u];
-    block_edges(blk, tri_ray, e);
+    block_edges(blk, block_ray, e);
     unsigned lanes = (e.full | e.finish) & (15u << (at % 4u));
     if (end - (at & ~3u) < 4u) lanes &= (1u << (end - (at & ~3u))) - 1u;
     while (lanes != 0u) {
