@@ -111,10 +111,14 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, Bloc
   const Float4 m = glm_max(glm_max(glm_max(glm_max(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),
                                    glm_max(glm_max(abs_d[1][0], abs_d[1][1]), abs_d[1][2])),
                            glm_max(glm_max(abs_d[2][0], abs_d[2][1]), abs_d[2][2]));
-  // unit_exponent(m) = clamp(-float_exponent(m), -126, 126); lanes with m == 0 end as zero edges.
-  const Int4 neg_exp = Int4(127) - ((xsimd::bitwise_cast<Int4>(m) >> 23) & Int4(255));
-  const Int4 ks = xsimd::select(neg_exp > Int4(126), Int4(126), xsimd::select(neg_exp < Int4(-126), Int4(-126), neg_exp));
-  const Float4 pow2_ks = xsimd::bitwise_cast<Float4>((ks + Int4(127)) << 23);
+  // unit_exponent(m) = clamp(-float_exponent(m), -126, 126), with the clamp done on m: its exponent
+  // field clamped to [1, 253] is m clamped to [2^-126, 2^126] (m >= 0), two float ops where SSE2 has
+  // no integer min or max.  Lanes with m == 0 end as zero edges; a NaN m (a NaN coordinate) gets
+  // some scale, which does not matter (above).
+  const Float4 m_clamped = glm_min(glm_max(m, Float4(0x1p-126f)), Float4(0x1p126f));
+  const Int4 field = xsimd::bitwise_cast<Int4>(m_clamped) >> 23;  // [1, 253] (255 for a NaN): no sign bit
+  const Int4 ks = Int4(127) - field;
+  const Float4 pow2_ks = xsimd::bitwise_cast<Float4>((Int4(254) - field) << 23);
   // A flush to zero needs a coordinate below 2^(-126 - ks); where none is, the product alone is exact.
   const Int4 one_minus_ks = Int4(1) - ks;
   const Float4 smallest = glm_min(glm_min(glm_min(glm_min(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),

@@ -337,6 +337,86 @@ TEST_CASE("four-lane scale_pow2 of the triangle blocks equals the kernel's", "[w
   CHECK(mismatches == 0);
 }
 
+// A float of random sign and mantissa with the exponent field `field` (0: denormal or zero).
+float float_with_field(Rng& rng, uint32_t field) {
+  const uint32_t mantissa = field == 0 && rng.gen() % 4 == 0 ? 0u : uint32_t(rng.gen()) & 0x7FFFFFu;
+  return std::bit_cast<float>((rng.gen() % 2 ? 0x80000000u : 0u) | field << 23 | mantissa);
+}
+
+TEST_CASE("triangle blocks: every lane gives the scalar kernel's hit, from denormal to huge coordinates", "[wide]") {
+  // The block test's rescale (max, exponent clamp to [-126, 126], flush rule) against
+  // lsk::ray_triangle, one lane at a time: triangles whose offsets from the origin have exponents
+  // across the float range, coincide with the origin, share it as a vertex, or hold an infinity or
+  // a NaN.  Expected from the kernel and offer_hit, as lsk::TraceContext::trace_leaf does.
+  Rng rng(17);
+  const uint32_t ids[4] = {0u, 1u, 2u, 3u};
+  lsk::TraceContext c{};
+  c.tri_ids = ids;
+  c.tri_instances = ids;
+  size_t mismatches = 0, hits = 0, tested = 0;
+  std::string first;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const glm::vec3 origin = trial % 2 ? rng.vec(-4.0f, 4.0f) : glm::vec3(0.0f);
+    glm::vec3 dir = rng.vec(-1.0f, 1.0f);
+    if (trial % 7 == 0) dir[trial % 3] = 0.0f;  // axis-parallel components
+    dir *= lsk::pow2(int(rng.gen() % 61) - 30);
+    if (dir == glm::vec3(0.0f)) continue;
+    ls::BlockRay block_ray;
+    block_ray.tri = lsk::make_tri_ray(origin, dir);
+    ls::broadcast_block_ray(block_ray);
+    // Each triangle at one scale: 2^e with e spread over the whole range, a third of them near the
+    // ray (on its line, plus small offsets) so that lanes pass the edge test.
+    ls::TriBlock block{};
+    glm::vec3 p[4][3];
+    for (int l = 0; l < 4; ++l) {
+      const uint32_t field = rng.gen() % 5 == 0 ? uint32_t(rng.gen() % 3) * 127u : 1u + uint32_t(rng.gen() % 253);
+      for (int k = 0; k < 3; ++k) {
+        glm::vec3 offset(float_with_field(rng, field), float_with_field(rng, field), float_with_field(rng, field));
+        if (l == 3)  // mixed scales within a triangle: denormal next to unit-sized coordinates (the flush rule)
+          for (int a = 0; a < 3; ++a) offset[a] = float_with_field(rng, rng.gen() % 2 ? uint32_t(rng.gen() % 3) : 127u);
+        if (rng.gen() % 3 == 0) offset = dir * std::abs(float_with_field(rng, field)) + offset * 0.25f;
+        p[l][k] = origin + offset;
+      }
+      switch (rng.gen() % 16) {
+        case 0: p[l][0] = origin; break;                                                // a vertex on the origin
+        case 1: p[l][0] = p[l][1] = p[l][2] = origin; break;                            // all of them: m == 0
+        case 2: p[l][rng.gen() % 3][rng.gen() % 3] = kInf; break;                       // an infinite coordinate
+        case 3: p[l][rng.gen() % 3][rng.gen() % 3] = std::numeric_limits<float>::quiet_NaN(); break;
+        case 4: p[l][2] = p[l][1]; break;                                               // degenerate: two equal vertices
+        default: break;
+      }
+      const glm::vec3 n = lsk::triangle_plane_normal(p[l][0], p[l][1], p[l][2]);
+      for (int a = 0; a < 3; ++a) {
+        for (int k = 0; k < 3; ++k) block.v[k][a][l] = p[l][k][a];
+        block.n[a][l] = n[a];
+      }
+      block.prim[l] = uint32_t(l);
+    }
+    for (int l = 0; l < 4; ++l) {
+      const float tmax = trial % 3 == 0 ? kInf : lsk::pow2(int(rng.gen() % 200) - 100);
+      lsk::Hit want{};
+      want.t = tmax;
+      want.instance = lsk::LS_INVALID;
+      want.triangle = lsk::LS_INVALID;
+      lsk::Hit got = want;
+      float t, u, v;
+      if (lsk::ray_triangle(block_ray.tri, 0.0f, want.t, p[l][0], p[l][1], p[l][2], t, u, v))
+        lsk::offer_hit(t, u, v, ids[l], ids[l], want);
+      uint32_t prim = lsk::LS_INVALID;
+      ls::trace_blocks(c, &block, uint32_t(l), 1u, block_ray, 0.0f, lsk::LS_INVALID, false, got, prim);
+      ++tested;
+      hits += want.triangle != lsk::LS_INVALID;
+      const bool same = std::memcmp(&want, &got, sizeof(lsk::Hit)) == 0 && (prim == want.triangle);
+      if (!same && mismatches++ == 0) first = "trial " + std::to_string(trial) + " lane " + std::to_string(l) + ": want " +
+                                              describe(want) + ", got " + describe(got);
+    }
+  }
+  INFO(first);
+  CHECK(mismatches == 0);
+  CHECK(tested > 70000);
+  CHECK(hits > 500);  // enough lanes pass the edge test to exercise the deciding half
+}
+
 TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
   const ls::Scene scene = random_scene(8);
   for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3", "2l-ls:0:3"}) {
