@@ -47,8 +47,8 @@ LS_FN vec3 ls_patch_point(IN(vec3) lo, IN(vec3) hi, uint patch_id, uint n, float
   uint j = rest / n;
   uint i = rest - j * n;
   uint a = face / 2u;
-  uint ua = (a + 1u) % 3u;
-  uint va = (a + 2u) % 3u;
+  uint ua = a == 2u ? 0u : a + 1u;  // the face's other two axes in cyclic order
+  uint va = a == 0u ? 2u : a - 1u;
   precise float fu = (float(i) + su) * inv_n;
   precise float fv = (float(j) + sv) * inv_n;
   vec3 p;
@@ -72,8 +72,8 @@ LS_FN vec4 ls_search_offsets(uint k) {
 // The patch a point on a face falls in; scale = N / extent per axis (host-computed).
 LS_FN uint ls_patch_of_point(IN(vec3) p, IN(vec3) lo, IN(vec3) scale, uint face, uint n) {
   uint a = face / 2u;
-  uint ua = (a + 1u) % 3u;
-  uint va = (a + 2u) % 3u;
+  uint ua = a == 2u ? 0u : a + 1u;  // the face's other two axes in cyclic order
+  uint va = a == 0u ? 2u : a - 1u;
   int last = int(n) - 1;
   int i = clamp(int(floor((p[ua] - lo[ua]) * scale[ua])), 0, last);
   int j = clamp(int(floor((p[va] - lo[va]) * scale[va])), 0, last);
