@@ -419,18 +419,35 @@ class WideTracer final : public FastTracer {
     trace_all(c, rays, hits, count, c.ls_enabled != 0u ? Query::AnyHit : Query::Occlusion);
   }
 
-  uint32_t find_candidate(lsk::TraceContext& c, const lsk::LsNode& ls, uint32_t shaft, uint32_t further_rays,
-                          uint32_t instance) const override {
-    for (uint k = 0u; k <= further_rays; ++k) {
-      vec3 a;
-      vec3 d;
-      if (!c.ls_search_segment(ls, shaft, k, a, d)) continue;
-      Hit hit = c.ls_search_hit();
+  void find_candidates(lsk::TraceContext& c, const lsk::LsNode& ls, const vec3* centres, uint32_t first, uint32_t end,
+                       uint32_t further_rays, uint32_t instance, uint32_t* prims) const override {
+    // The shafts in index order: start patch s / (5 N^2), end patch its rank among the patches off
+    // the start face (lsk::ls_shaft_patches), stepped on without dividing.
+    const uint nn = ls.n * ls.n;
+    uint start_patch, first_end_patch;
+    lsk::ls_shaft_patches(first, ls.n, start_patch, first_end_patch);
+    uint end_rank = first - start_patch * 5u * nn;
+    uint start_face_first = (start_patch / nn) * nn;  // the start face's first patch
+    for (uint32_t s = first; s != end; ++s) {
+      const uint end_patch_s = end_rank >= start_face_first ? end_rank + nn : end_rank;
       uint prim = LS_INVALID;
-      trace_bvh(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
-      if (prim != LS_INVALID) return prim;
+      vec3 a = centres[start_patch];
+      vec3 d;
+      if (c.ls_segment(a, centres[end_patch_s], d)) {  // search ray 0 joins the patch centres
+        Hit hit = c.ls_search_hit();
+        trace_bvh(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+      }
+      for (uint k = 1u; k <= further_rays && prim == LS_INVALID; ++k) {
+        if (!c.ls_search_segment(ls, s, k, a, d)) continue;
+        Hit hit = c.ls_search_hit();
+        trace_bvh(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+      }
+      prims[s - first] = prim;
+      if (++end_rank == 5u * nn) {
+        end_rank = 0u;
+        if (++start_patch % nn == 0u) start_face_first += nn;
+      }
     }
-    return LS_INVALID;
   }
 
   size_t bytes() const override {

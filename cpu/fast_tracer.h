@@ -38,11 +38,12 @@ class FastTracer {
   // order finds first, since the exact structures are walked order-free here.  Structures with a
   // Line Space answer as trace(..., any_hit = true) does (their counters depend on the order).
   virtual void occluded(lsk::TraceContext& context, const lsk::Ray* rays, lsk::Hit* hits, size_t count) const = 0;
-  // lsk::TraceContext::ls_find_candidate on the fast path, the same candidate bit for bit: each
-  // search segment is a closest-hit query in the LS node's own subtree, which the order-free walk
-  // answers (the node is an entry of the exact wide tree).
-  virtual uint32_t find_candidate(lsk::TraceContext& context, const lsk::LsNode& ls, uint32_t shaft, uint32_t further_rays,
-                                  uint32_t instance) const = 0;
+  // lsk::TraceContext::ls_find_candidate of the shafts [first, end) of an LS node on the fast path,
+  // the same candidates bit for bit, into prims[0, end - first): each search segment is a
+  // closest-hit query in the LS node's own subtree, which the order-free walk answers (the node is
+  // an entry of the exact wide tree).  centres: ls_patch_centres(ls), the ends of search ray 0.
+  virtual void find_candidates(lsk::TraceContext& context, const lsk::LsNode& ls, const lsk::vec3* centres, uint32_t first,
+                               uint32_t end, uint32_t further_rays, uint32_t instance, uint32_t* prims) const = 0;
   virtual size_t bytes() const = 0;  // the wide nodes and their index
   virtual int width() const = 0;     // 4 or 8
   // A tracer for the same Accel after its top level was rebuilt or refitted (top_level_update.h):

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <mutex>
 #include <set>
+#include <stdexcept>
 
 namespace ls {
 namespace {
@@ -289,12 +290,13 @@ void search_line_space(const LsOptions& options, Accel& accel) {
     const lsk::LsNode ls_node = accel.ls_nodes[li];  // (not `ls`: that would hide namespace ls)
     const uint32_t shafts = lsk::ls_shaft_count(ls_node.n);
     std::vector<uint32_t> prims(shafts);
+    const std::vector<lsk::vec3> centres = ls_patch_centres(ls_node);
     ls::parallel_for(tbb::blocked_range<uint32_t>(0, shafts, 512), [&](const tbb::blocked_range<uint32_t>& r) {
       throw_if_interrupted();  // TBB cancels the other blocks and rethrows in the caller
       lsk::TraceContext c = context;
       if (fast)
-        for (uint32_t s = r.begin(); s != r.end(); ++s)
-          prims[s] = fast->find_candidate(c, ls_node, s, uint32_t(options.further_rays), instance);
+        fast->find_candidates(c, ls_node, centres.data(), r.begin(), r.end(), uint32_t(options.further_rays), instance,
+                              prims.data() + r.begin());
       else
         for (uint32_t s = r.begin(); s != r.end(); ++s)
           prims[s] = c.ls_find_candidate(ls_node.node, ls_node, s, uint32_t(options.further_rays), instance);
@@ -315,6 +317,14 @@ void build_line_space(const Scene& scene, const LsOptions& options, Accel& accel
   layout_line_space(scene, options, accel);
   search_line_space(options, accel);
   accel.ls_info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<lsk::vec3> ls_patch_centres(const lsk::LsNode& ls) {
+  const lsk::vec4 s = lsk::ls_search_offsets(0u);  // (0.5, 0.5, 0.5, 0.5): one table for both ends
+  if (s.x != s.z || s.y != s.w) throw std::logic_error("ls_patch_centres: search ray 0 no longer joins like points");
+  std::vector<lsk::vec3> centres(6u * ls.n * ls.n);
+  for (uint32_t p = 0; p < centres.size(); ++p) centres[p] = lsk::ls_patch_point(ls.lo, ls.hi, p, ls.n, ls.inv_n, s.x, s.y);
+  return centres;
 }
 
 uint32_t ls_search_instance(const Accel& accel) { return accel.spec.two_level() ? 0u : lsk::LS_INVALID; }

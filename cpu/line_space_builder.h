@@ -100,6 +100,10 @@ size_t pack_ls_candidates(Accel& accel, size_t ls_index, const uint32_t* prims);
 // one node share words: not concurrently within a node.
 void store_ls_candidate(Accel& accel, size_t ls_index, uint32_t shaft, uint32_t prim);
 
+// The centres of an LS node's 6 N^2 patches (lsk::ls_patch_point at ls_search_offsets(0)), indexed by
+// patch: the ends of every shaft's first search ray, made once a node for the fast path's search.
+std::vector<lsk::vec3> ls_patch_centres(const lsk::LsNode& ls);
+
 // The `instance` argument of ls_find_candidate() for this structure (0 for 2L, LS_INVALID for F).
 uint32_t ls_search_instance(const Accel& accel);
 

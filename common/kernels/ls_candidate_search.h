@@ -5,6 +5,13 @@
 // Each is traced as the closed segment between its two points, closest hit, against the node's own
 // subtree only and without any Line Space.  The first that hits gives the candidate (an index into
 // tris[]); none hits: the shaft is empty (LS_INVALID).  N and 1 / N are the LS node's own (host-made).
+// The search segment from a to b as a + t d, t in [0, 1]; false when it has no length (skipped).
+LS_FN bool ls_segment(IN(vec3) a, IN(vec3) b, OUT(vec3) d) {
+  precise vec3 ab = b - a;
+  d = ab;
+  return !(ab.x == 0.0f && ab.y == 0.0f && ab.z == 0.0f);
+}
+
 // The k-th search segment of a shaft, from a to a + d; false when it has no length (skipped).
 LS_FN bool ls_search_segment(IN(LsNode) ls, uint shaft, uint k, OUT(vec3) a, OUT(vec3) d) {
   uint start_patch;
@@ -13,9 +20,7 @@ LS_FN bool ls_search_segment(IN(LsNode) ls, uint shaft, uint k, OUT(vec3) a, OUT
   vec4 s = ls_search_offsets(k);
   a = ls_patch_point(ls.lo, ls.hi, start_patch, ls.n, ls.inv_n, s.x, s.y);
   vec3 b = ls_patch_point(ls.lo, ls.hi, end_patch, ls.n, ls.inv_n, s.z, s.w);
-  precise vec3 ab = b - a;
-  d = ab;
-  return !(ab.x == 0.0f && ab.y == 0.0f && ab.z == 0.0f);
+  return ls_segment(a, b, d);
 }
 
 // The segment's hit to start from: t = 1 (its far end), no triangle.
