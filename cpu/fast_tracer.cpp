@@ -435,12 +435,12 @@ class WideTracer final : public FastTracer {
       vec3 d;
       if (c.ls_segment(a, centres[end_patch_s], d)) {  // search ray 0 joins the patch centres
         Hit hit = c.ls_search_hit();
-        trace_bvh(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+        trace_bvh<true>(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
       }
       for (uint k = 1u; k <= further_rays && prim == LS_INVALID; ++k) {
         if (!c.ls_search_segment(ls, s, k, a, d)) continue;
         Hit hit = c.ls_search_hit();
-        trace_bvh(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+        trace_bvh<true>(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
       }
       prims[s - first] = prim;
       if (++end_rank == 5u * nn) {
@@ -482,7 +482,11 @@ class WideTracer final : public FastTracer {
   // the order-free walk below the entries it reaches, except for the reference's any hit.  Returns
   // true when an any-hit or occlusion query found its hit (the caller stops).  Always inlined: GCC
   // otherwise chose by a hair whether an instance's walk sat in the top walk or behind a call
-  // (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change elsewhere).
+  // (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change elsewhere).  kSearch:
+  // the LS build's search gets its own copy of the walks it inlines; sharing them added a caller
+  // to the instance's exact walk, which GCC then left out of line (2l-bvh on generated 3,388 ->
+  // 3,483).
+  template <bool kSearch = false>
   LS_ALWAYS_INLINE bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin,
                                   uint instance, Query q, bool use_ls, Hit& hit, uint& hit_prim) const {
     const bool any_hit = q != Query::Closest;
