@@ -9,6 +9,7 @@ packages=(build-essential cmake ninja-build pkg-config
   glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
   mesa-vulkan-drivers libvulkan-dev vulkan-tools
   python3-matplotlib   # linespace-validate sweep plots (validate/plot_tradeoff.py)
+  valgrind             # scripts/profile-callgrind.sh (instructions a ray, docs/performance.md)
   python3 sweethome3d-furniture libcgal-demo  # the real scenes: assembler, sources (scenes/README.md)
   clang-14 libclang-rt-14-dev)  # clang-14 + its runtimes: the libFuzzer harnesses (scripts/run-sanitizers.sh)
 
