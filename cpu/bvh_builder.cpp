@@ -1,8 +1,9 @@
 // The binned SAH builder.  Its trees are bit for bit those of the plain formulation (bin the
 // centroids, sweep every boundary, std::partition, recurse; tests/test_bvh.cpp recomputes every
 // split by brute force): the speed comes from doing the same work with less memory traffic —
-// primitives moved with their boxes, each side's bounds gathered while partitioning, only occupied
-// bins swept, 4-float SIMD for the box arithmetic, small subtrees laid out directly.
+// primitives moved with their boxes, each side's bounds gathered while partitioning, a large range's
+// bins initialised up front so that binning has no branch, only occupied bins swept, 4-float SIMD
+// for the box arithmetic, small subtrees laid out directly.
 #include "bvh_builder.h"
 
 #include "huge_pages.h"
@@ -20,8 +21,13 @@
 namespace ls {
 namespace {
 
-constexpr uint32_t kParallelRange = 4096;  // ranges larger than this are binned and split in parallel
+constexpr uint32_t kParallelBinning = 4096;  // ranges larger than this are binned in parallel
+// Ranges larger than this build their two subtrees as parallel tasks: low enough that a scene of a
+// few thousand triangles uses every thread (cornell's 4,026 took 1.0-1.4 ms on one), high enough
+// that a task's work dwarfs its scheduling.
+constexpr uint32_t kParallelSubtrees = 1024;
 constexpr int kMaxBins = 64;
+constexpr uint32_t kDenseBinning = 16;  // ranges at least this large initialise all bins (BinSet::make_dense)
 
 float half_area(const Bounds& b) {
   if (b.empty()) return 0.0f;
@@ -29,7 +35,7 @@ float half_area(const Bounds& b) {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-// A node above the serially built subtrees (ranges over kParallelRange), kept until the tree is
+// A node above the serially built subtrees (ranges over kParallelSubtrees), kept until the tree is
 // complete and laid out depth first.
 struct TempNode {
   Bounds box;
@@ -79,20 +85,21 @@ struct Box4 {
   }
 };
 
-// half_area of a box, as the scalar rule: 0 when empty (lo.x > hi.x), else e.x * e.y + e.y * e.z +
-// e.z * e.x of its extent.
+// half_area of a box, as the scalar rule: 0 when empty (lo.x > hi.x, which is e.x < 0 of the exact
+// difference), else e.x * e.y + e.y * e.z + e.z * e.x of its extent, summed in that order.
 float half_area4(const Box4& b) {
-  alignas(16) float lo[4], hi[4], e[4];
-  b.lo.store_aligned(lo);
-  b.hi.store_aligned(hi);
-  if (lo[0] > hi[0]) return 0.0f;
-  (b.hi - b.lo).store_aligned(e);
-  return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+  const Float4 e = b.hi - b.lo;
+  const Float4 products = e * xsimd::swizzle(e, xsimd::batch_constant<xsimd::batch<uint32_t, Simd4Arch>, 1, 2, 0, 3>());
+  alignas(16) float ev[4], pv[4];
+  e.store_aligned(ev);
+  products.store_aligned(pv);
+  if (ev[0] < 0.0f) return 0.0f;
+  return pv[0] + pv[1] + pv[2];
 }
 
 // Per axis and bin, the box and the number of the primitives whose centroid falls in it, for the
 // bins set in the axis' `occupied` mask; the others are not initialised (a set is 9 KB, a small range
-// touches a few of its bins).
+// touches a few of its bins) until make_dense, after which add_dense needs no test.
 struct BinSet {
   struct alignas(16) Box {
     float lo[4], hi[4];
@@ -116,6 +123,29 @@ struct BinSet {
       count[a][b] = n;
     }
   }
+  // Initialises the unoccupied bins below `bins` as empty boxes: the bins of a large range, where a
+  // test and branch per axis and primitive costs more than these stores.
+  void make_dense(int bins) {
+    const Float4 inf(std::numeric_limits<float>::infinity());
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < bins; ++b)
+        if (!(occupied[a] >> b & 1)) {
+          inf.store_aligned(box[a][b].lo);
+          (-inf).store_aligned(box[a][b].hi);
+          count[a][b] = 0;
+        }
+    dense = true;
+  }
+  // add(a, b, lo, hi, 1) once make_dense has run: growing an empty box gives the box itself
+  // (min(+inf, x) is x for every non-NaN x, -0 included).
+  void add_dense(int a, int b, const Float4& lo, const Float4& hi) {
+    occupied[a] |= uint64_t(1) << b;
+    Box& bb = box[a][b];
+    glm_min(Float4::load_aligned(bb.lo), lo).store_aligned(bb.lo);
+    glm_max(Float4::load_aligned(bb.hi), hi).store_aligned(bb.hi);
+    ++count[a][b];
+  }
+  bool dense = false;
   void merge(const BinSet& o) {
     for (int a = 0; a < 3; ++a)
       for (uint64_t m = o.occupied[a]; m; m &= m - 1) {
@@ -171,7 +201,7 @@ class Builder {
       for (uint32_t i = r.begin(); i != r.end(); ++i) info.add(prims_[i]);
       return info;
     };
-    if (end - begin <= kParallelRange) return body(tbb::blocked_range<uint32_t>(begin, end), RangeInfo{});
+    if (end - begin <= kParallelBinning) return body(tbb::blocked_range<uint32_t>(begin, end), RangeInfo{});
     return ls::parallel_reduce(tbb::blocked_range<uint32_t>(begin, end, 1024), RangeInfo{}, body,
                                [](RangeInfo a, const RangeInfo& b) { a.merge(b); return a; });
   }
@@ -184,20 +214,28 @@ class Builder {
   void bin_into(BinSet& set, uint32_t begin, uint32_t end, const Bounds& cb, const glm::vec3& scale) const {
     alignas(16) const float lo_lanes[4] = {cb.lo.x, cb.lo.y, cb.lo.z, 0.0f}, scale_lanes[4] = {scale.x, scale.y, scale.z, 0.0f};
     const Float4 lo4 = Float4::load_aligned(lo_lanes), scale4 = Float4::load_aligned(scale_lanes);
-    const int last = bins_ - 1;
-    for (uint32_t i = begin; i != end; ++i) {
-      const PrimRef& p = prims_[i];
-      const Float4 lo = p.lo4(), hi = p.hi4();
-      // bin_of on three lanes: the truncation is cvttps's, the clamp the scalar one.
-      alignas(16) int32_t b[4];
-      xsimd::to_int((centre4(lo, hi) - lo4) * scale4).store_aligned(b);
-      for (int a = 0; a < 3; ++a) set.add(a, std::clamp(b[a], 0, last), lo, hi, 1);
-    }
+    const Int4 zero4(0), last4(bins_ - 1);
+    auto each = [&](auto add) LS_ALWAYS_LAMBDA {
+      for (uint32_t i = begin; i != end; ++i) {
+        const PrimRef& p = prims_[i];
+        const Float4 lo = p.lo4(), hi = p.hi4();
+        // bin_of on three lanes: the truncation is cvttps's, the clamp the scalar one.
+        alignas(16) int32_t b[4];
+        const Int4 raw = xsimd::to_int((centre4(lo, hi) - lo4) * scale4);
+        xsimd::select(raw > last4, last4, xsimd::select(raw < zero4, zero4, raw)).store_aligned(b);
+        for (int a = 0; a < 3; ++a) add(a, b[a], lo, hi);
+      }
+    };
+    if (!set.dense && end - begin >= kDenseBinning) set.make_dense(bins_);
+    if (set.dense)
+      each([&](int a, int b, const Float4& lo, const Float4& hi) LS_ALWAYS_LAMBDA { set.add_dense(a, b, lo, hi); });
+    else
+      each([&](int a, int b, const Float4& lo, const Float4& hi) LS_ALWAYS_LAMBDA { set.add(a, b, lo, hi, 1); });
   }
 
   // Fills `set` (serially for small ranges: no copies of the 5 KB set).
   void bin(BinSet& set, uint32_t begin, uint32_t end, const Bounds& cb, const glm::vec3& scale) const {
-    if (end - begin <= kParallelRange) return bin_into(set, begin, end, cb, scale);
+    if (end - begin <= kParallelBinning) return bin_into(set, begin, end, cb, scale);
     set = ls::parallel_reduce(
         tbb::blocked_range<uint32_t>(begin, end, 4096), BinSet{},
         [&](const tbb::blocked_range<uint32_t>& r, BinSet part) {
@@ -329,7 +367,7 @@ class Builder {
     node->begin = begin;
     node->end = end;
     node->box = info.box();
-    if (end - begin <= kParallelRange) {
+    if (end - begin <= kParallelSubtrees) {
       node->subtree.emplace_back();
       build_serial(begin, end, depth, info, 0, node->subtree);
       return node;
