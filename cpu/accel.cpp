@@ -46,8 +46,10 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
   const size_t total = first.back();
   std::vector<lsk::Triangle> world;
   std::vector<Bounds> boxes;
+  std::vector<uint32_t> instance_of;  // each world triangle's instance: no search per triangle below
   resize_huge(world, total);
   resize_huge(boxes, total);
+  resize_huge(instance_of, total);
   ls::parallel_for(size_t(0), scene.instances.size(), [&](size_t i) {
     const Instance& inst = scene.instances[i];
     const Mesh& mesh = scene.meshes[inst.mesh];
@@ -58,6 +60,7 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
       const glm::vec3 c = transform_point(inst.object_to_world, mesh.positions[idx.z]);
       world[first[i] + t] = make_triangle(a, b, c);
       boxes[first[i] + t] = triangle_bounds(a, b, c);
+      instance_of[first[i] + t] = uint32_t(i);
     });
   });
   BvhBuildResult bvh = build_bvh(boxes, options);
@@ -68,10 +71,10 @@ void build_flat(const Scene& scene, const BvhBuildOptions& options, Accel& accel
   resize_huge(accel.tri_instances, total);
   ls::parallel_for(size_t(0), total, [&](size_t k) {
     const size_t src = bvh.order[k];
-    const size_t inst = size_t(std::upper_bound(first.begin(), first.end(), src) - first.begin()) - 1;
+    const uint32_t inst = instance_of[src];
     accel.tris[k] = world[src];
     accel.tri_ids[k] = uint32_t(src - first[inst]);
-    accel.tri_instances[k] = uint32_t(inst);
+    accel.tri_instances[k] = inst;
   });
   const std::vector<bool> used = used_meshes(scene);
   accel.objects = size_t(std::count(used.begin(), used.end(), true));
