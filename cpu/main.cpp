@@ -43,19 +43,19 @@ void print_bench(const BenchResult& r, bool json) {
               r.threads, r.repeats, r.cpu.c_str());
   std::printf("fast path: %d-wide BVH, %s; reference: the scalar single-source kernels\n", r.wide_width, r.isa.c_str());
   std::printf("%-14s %10s %10s %10s %10s %9s %10s %9s %9s\n", "structure", "fast MR/s", "vs Embree", "vs bvh", "ref MR/s",
-              "ref vs E", "fast/ref", "MB", "build s");
+              "ref vs E", "fast/ref", "MB", "build ms");
   for (const BenchEntry& e : r.results) {
     if (e.structure == "embree") {
-      std::printf("%-14s %10.2f %9.2fx %10s %10s %9s %10s %9.2f %9.3f\n", e.structure.c_str(), e.mrays_per_s,
-                  e.ratio_vs_embree, "", "", "", "", double(e.bytes) / 1e6, e.build_seconds);
+      std::printf("%-14s %10.2f %9.2fx %10s %10s %9s %10s %9.2f %9.2f\n", e.structure.c_str(), e.mrays_per_s,
+                  e.ratio_vs_embree, "", "", "", "", double(e.bytes) / 1e6, e.build_seconds * 1e3);
       continue;
     }
     char vs_bvh[16] = "-";  // no bvh in the run
     if (e.ratio_vs_fast_bvh > 0.0) std::snprintf(vs_bvh, sizeof(vs_bvh), "%.2fx", e.ratio_vs_fast_bvh);
-    std::printf("%-14s %10.2f %9.2fx %10s %10.2f %8.2fx %9.2fx %9.2f %9.3f\n", e.structure.c_str(), e.mrays_per_s,
+    std::printf("%-14s %10.2f %9.2fx %10s %10.2f %8.2fx %9.2fx %9.2f %9.2f\n", e.structure.c_str(), e.mrays_per_s,
                 e.ratio_vs_embree, vs_bvh, e.reference_mrays_per_s, e.reference_ratio_vs_embree,
                 e.reference_mrays_per_s > 0.0 ? e.mrays_per_s / e.reference_mrays_per_s : 0.0,
-                double(e.bytes + e.bytes_wide) / 1e6, e.build_seconds);
+                double(e.bytes + e.bytes_wide) / 1e6, e.build_seconds * 1e3);
   }
 }
 

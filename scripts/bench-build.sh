@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Build seconds of the F-BVH and the 2L-BVH beside Embree 3's high-quality build of the same scene,
+# Build milliseconds of the F-BVH and the 2L-BVH beside Embree 3's high-quality build of the same scene,
 # medians of RUNS runs of `linespace-cpu bench` (Embree builds in the same runs as ours).
 #   scripts/bench-build.sh [SCENE ...]        default: the built-in scenes and assets/real/*.glb
 #   RUNS=3                                    runs per scene
 #   LINESPACE_CPU=build/release/cpu/linespace-cpu
 #   COMPARE=/path/to/other/linespace-cpu      also time another build (e.g. an older commit), the two
 #                                             binaries alternating run by run
-# Prints a Markdown table (seconds; "x" = ours / Embree).  docs/performance.md, "Build speed".
+# Prints a Markdown table (milliseconds; "x" = ours / Embree).  docs/performance.md, "Build speed".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${LINESPACE_CPU:-build/release/cpu/linespace-cpu}
@@ -20,12 +20,12 @@ if [[ ${#scenes[@]} -eq 0 ]]; then
 fi
 
 median() { sort -g | awk '{v[NR] = $1} END {print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
-# bench's last column is the build seconds of each structure and of Embree.
+# bench's last column is the build milliseconds of each structure and of Embree.
 times() { "$1" bench --scene "$2" --count 1000 --repeat 1 --structures bvh,2l-bvh | awk '$1 == "bvh" || $1 == "2l-bvh" || $1 == "embree" {print $1, $NF}'; }
 
-header="| scene | F-BVH s | Embree HQ s | F-BVH / Embree | 2L-BVH s |"
+header="| scene | F-BVH ms | Embree HQ ms | F-BVH / Embree | 2L-BVH ms |"
 rule="|---|---|---|---|---|"
-[[ -n ${COMPARE:-} ]] && header+=" F-BVH s (COMPARE) | its Embree s | F-BVH / Embree (COMPARE) |" && rule+="---|---|---|"
+[[ -n ${COMPARE:-} ]] && header+=" F-BVH ms (COMPARE) | its Embree ms | F-BVH / Embree (COMPARE) |" && rule+="---|---|---|"
 echo "$header"
 echo "$rule"
 for scene in "${scenes[@]}"; do
