@@ -49,13 +49,14 @@ struct TempNode {
 // A primitive as the builder moves it: its box and input index side by side, so that binning and
 // partitioning read memory in order instead of gathering through an index array.  Its two halves are
 // loaded as 4-float batches; `id` sits in lo's fourth lane and is masked off before any arithmetic.
+// Plain arrays: an axis chosen at run time is an index, where glm's operator[] is a switch.
 struct alignas(16) PrimRef {
-  glm::vec3 lo;
+  float lo[3];
   uint32_t id;
-  glm::vec3 hi;
+  float hi[3];
   float zero = 0.0f;
-  Float4 lo4() const { return xsimd::bitwise_and(Float4::load_aligned(&lo.x), xyz_mask()); }
-  Float4 hi4() const { return Float4::load_aligned(&hi.x); }
+  Float4 lo4() const { return xsimd::bitwise_and(Float4::load_aligned(lo), xyz_mask()); }
+  Float4 hi4() const { return Float4::load_aligned(hi); }
   static Float4 xyz_mask() {
     alignas(16) static constexpr int32_t bits[4] = {-1, -1, -1, 0};
     return xsimd::bitwise_cast<Float4>(Int4::load_aligned(bits));
@@ -99,7 +100,7 @@ float half_area4(const Box4& b) {
 
 // Per axis and bin, the box and the number of the primitives whose centroid falls in it, for the
 // bins set in the axis' `occupied` mask; the others are not initialised (a set is 9 KB, a small range
-// touches a few of its bins) until make_dense, after which add_dense needs no test.
+// touches a few of its bins) until make_dense, after which grow_dense needs no test.
 struct BinSet {
   struct alignas(16) Box {
     float lo[4], hi[4];
@@ -136,10 +137,9 @@ struct BinSet {
         }
     dense = true;
   }
-  // add(a, b, lo, hi, 1) once make_dense has run: growing an empty box gives the box itself
-  // (min(+inf, x) is x for every non-NaN x, -0 included).
-  void add_dense(int a, int b, const Float4& lo, const Float4& hi) {
-    occupied[a] |= uint64_t(1) << b;
+  // add(a, b, lo, hi, 1) once make_dense has run, but for the `occupied` bit, which the caller sets:
+  // growing an empty box gives the box itself (min(+inf, x) is x for every non-NaN x, -0 included).
+  void grow_dense(int a, int b, const Float4& lo, const Float4& hi) {
     Box& bb = box[a][b];
     glm_min(Float4::load_aligned(bb.lo), lo).store_aligned(bb.lo);
     glm_max(Float4::load_aligned(bb.hi), hi).store_aligned(bb.hi);
@@ -178,7 +178,8 @@ class Builder {
       : options_(options), bins_(std::clamp(options.bins, 2, kMaxBins)) {
     resize_huge(prims_, boxes.size());
     ls::parallel_for(size_t(0), boxes.size(), [&](size_t i) {
-      prims_[i] = PrimRef{boxes[i].lo, uint32_t(i), boxes[i].hi};
+      const Bounds& b = boxes[i];
+      prims_[i] = PrimRef{{b.lo.x, b.lo.y, b.lo.z}, uint32_t(i), {b.hi.x, b.hi.y, b.hi.z}};
     });
   }
 
@@ -227,9 +228,14 @@ class Builder {
       }
     };
     if (!set.dense && end - begin >= kDenseBinning) set.make_dense(bins_);
-    if (set.dense)
-      each([&](int a, int b, const Float4& lo, const Float4& hi) LS_ALWAYS_LAMBDA { set.add_dense(a, b, lo, hi); });
-    else
+    if (set.dense) {
+      uint64_t occupied[3] = {set.occupied[0], set.occupied[1], set.occupied[2]};  // in registers, not memory
+      each([&](int a, int b, const Float4& lo, const Float4& hi) LS_ALWAYS_LAMBDA {
+        occupied[a] |= uint64_t(1) << b;
+        set.grow_dense(a, b, lo, hi);
+      });
+      for (int a = 0; a < 3; ++a) set.occupied[a] = occupied[a];
+    } else
       each([&](int a, int b, const Float4& lo, const Float4& hi) LS_ALWAYS_LAMBDA { set.add(a, b, lo, hi, 1); });
   }
 
