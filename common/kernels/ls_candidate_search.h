@@ -5,6 +5,7 @@
 // Each is traced as the closed segment between its two points, closest hit, against the node's own
 // subtree only and without any Line Space.  The first that hits gives the candidate (an index into
 // tris[]); none hits: the shaft is empty (LS_INVALID).  N and 1 / N are the LS node's own (host-made).
+
 // The search segment from a to b as a + t d, t in [0, 1]; false when it has no length (skipped).
 LS_FN bool ls_segment(IN(vec3) a, IN(vec3) b, OUT(vec3) d) {
   precise vec3 ab = b - a;
