@@ -100,7 +100,7 @@ float half_area4(const Box4& b) {
 
 // Per axis and bin, the box and the number of the primitives whose centroid falls in it, for the
 // bins set in the axis' `occupied` mask; the others are not initialised (a set is 9 KB, a small range
-// touches a few of its bins) until make_dense, after which grow_dense needs no test.
+// touches a few of its bins) until make_dense, after which grow needs no test.
 struct BinSet {
   struct alignas(16) Box {
     float lo[4], hi[4];
@@ -108,24 +108,28 @@ struct BinSet {
   std::array<std::array<Box, kMaxBins>, 3> box;
   std::array<std::array<uint32_t, kMaxBins>, 3> count;
   std::array<uint64_t, 3> occupied{};
+  bool dense = false;  // every bin below the bin count initialised (make_dense)
+  // Grows bin b of axis a, which holds a box (occupied, or initialised empty by make_dense), by a
+  // box of n primitives; the caller keeps `occupied`.
+  void grow(int a, int b, const Float4& lo, const Float4& hi, uint32_t n) {
+    Box& bb = box[a][b];
+    glm_min(Float4::load_aligned(bb.lo), lo).store_aligned(bb.lo);
+    glm_max(Float4::load_aligned(bb.hi), hi).store_aligned(bb.hi);
+    count[a][b] += n;
+  }
   void add(int a, int b, const Float4& lo, const Float4& hi, uint32_t n) {
     const uint64_t bit = uint64_t(1) << b;
-    Box& bb = box[a][b];
-    if (occupied[a] & bit) {
-      glm_min(Float4::load_aligned(bb.lo), lo).store_aligned(bb.lo);
-      glm_max(Float4::load_aligned(bb.hi), hi).store_aligned(bb.hi);
-      count[a][b] += n;
-    } else {
-      // The first: what growing an empty box by it gives (min(+inf, x) is x for every non-NaN x, -0
-      // included; scene validation refuses NaN).
-      occupied[a] |= bit;
-      lo.store_aligned(bb.lo);
-      hi.store_aligned(bb.hi);
-      count[a][b] = n;
-    }
+    if (occupied[a] & bit) return grow(a, b, lo, hi, n);
+    // The first: what growing an empty box by it gives (min(+inf, x) is x for every non-NaN x, -0
+    // included; scene validation refuses NaN).
+    occupied[a] |= bit;
+    lo.store_aligned(box[a][b].lo);
+    hi.store_aligned(box[a][b].hi);
+    count[a][b] = n;
   }
   // Initialises the unoccupied bins below `bins` as empty boxes: the bins of a large range, where a
-  // test and branch per axis and primitive costs more than these stores.
+  // test and branch per axis and primitive costs more than these stores.  Growing an empty box gives
+  // the box itself, as add's first store does.
   void make_dense(int bins) {
     const Float4 inf(std::numeric_limits<float>::infinity());
     for (int a = 0; a < 3; ++a)
@@ -137,15 +141,6 @@ struct BinSet {
         }
     dense = true;
   }
-  // add(a, b, lo, hi, 1) once make_dense has run, but for the `occupied` bit, which the caller sets:
-  // growing an empty box gives the box itself (min(+inf, x) is x for every non-NaN x, -0 included).
-  void grow_dense(int a, int b, const Float4& lo, const Float4& hi) {
-    Box& bb = box[a][b];
-    glm_min(Float4::load_aligned(bb.lo), lo).store_aligned(bb.lo);
-    glm_max(Float4::load_aligned(bb.hi), hi).store_aligned(bb.hi);
-    ++count[a][b];
-  }
-  bool dense = false;
   void merge(const BinSet& o) {
     for (int a = 0; a < 3; ++a)
       for (uint64_t m = o.occupied[a]; m; m &= m - 1) {
@@ -232,7 +227,7 @@ class Builder {
       uint64_t occupied[3] = {set.occupied[0], set.occupied[1], set.occupied[2]};  // in registers, not memory
       each([&](int a, int b, const Float4& lo, const Float4& hi) LS_ALWAYS_LAMBDA {
         occupied[a] |= uint64_t(1) << b;
-        set.grow_dense(a, b, lo, hi);
+        set.grow(a, b, lo, hi, 1);
       });
       for (int a = 0; a < 3; ++a) set.occupied[a] = occupied[a];
     } else
