@@ -24,7 +24,7 @@ std::string cpu_model() {
 }
 
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats, const AccelOptions& options, bool any_hit) {
+                      int repeats, const AccelOptions& options, bool any_hit, const std::string& embree_isa) {
   BenchResult result;
   result.rays = rays.size();
   result.threads = tbb::info::default_concurrency();
@@ -36,7 +36,8 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
 
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) built.push_back(build_accel(scene, spec, options));
-  EmbreeTracer embree(scene);
+  EmbreeTracer embree(scene, embree_isa);
+  result.embree_isa = embree.isa();
 
   // Runs: per structure the fast path, then the reference; Embree last.
   std::vector<lsk::Hit> hits(rays.size());

@@ -33,14 +33,17 @@ struct BenchResult {
   int repeats = 0;
   std::string cpu;          // CPU model from /proc/cpuinfo
   std::string isa;          // the fast path's SIMD instruction set
+  std::string embree_isa;   // the one Embree ran (embree_effective_isa)
   int wide_width = 0;
   bool any_hit = false;
   std::vector<BenchEntry> results;  // the structures in the order asked, Embree last
 };
 
-// any_hit: occlusion queries (rtcOccluded1 for Embree), e.g. for shadow rays.
+// any_hit: occlusion queries (rtcOccluded1 for Embree), e.g. for shadow rays.  embree_isa: one of
+// embree_isa_names() (embree_tracer.h).
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats, const AccelOptions& options = {}, bool any_hit = false);
+                      int repeats, const AccelOptions& options = {}, bool any_hit = false,
+                      const std::string& embree_isa = "best");
 
 std::string cpu_model();
 

@@ -2,6 +2,7 @@
 
 #include "cli_flags.h"
 #include "cli_report.h"
+#include "embree_tracer.h"
 #include "interrupt.h"
 #include "load_scene.h"
 #include "memory_budget.h"
@@ -43,6 +44,7 @@ struct Values {
   int repeats = 5;
   std::string bench_kind = "diffuse";
   bool bench_any_hit = false;
+  std::string embree_isa = "best";
   uint32_t tile_size = 32;  // sharded renders (render_shards.h)
   std::string tiles, shard;
   std::string throughput_switch;  // "T:STRUCTURE" (throughput_switch.h)
@@ -128,6 +130,11 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.bench->add_option("--structures", v.structures, "comma-separated structures")->capture_default_str();
   c.bench->add_option("--repeat", v.repeats, "timed runs per structure (median reported)")->capture_default_str()->check(CLI::Range(1, 100));
   c.bench->add_flag("--json", v.json, "machine-readable output");
+  if (!info.device_flag)  // the CPU program runs Embree beside its structures
+    c.bench->add_option("--embree-isa", v.embree_isa,
+                        "Embree's instruction set: best (its own choice for this CPU) or a limit, e.g. sse2 to match "
+                        "a portable build")
+        ->capture_default_str()->check(CLI::IsMember(embree_isa_names()));
   return c;
 }
 
@@ -265,7 +272,7 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
     const std::vector<lsk::Ray> rays = v.rays_path.empty() ? make_rays(scene, v.bench_kind, v.count, v.seed) : read_rays(v.rays_path);
     if (rays.empty()) throw InputError("bench: the ray file holds no rays");
     const bool occlusion = v.bench_any_hit || (v.rays_path.empty() && v.bench_kind == "shadow");
-    backend->bench(scene, rays, specs, v.repeats, v.ls.options(), occlusion, v.json);
+    backend->bench(scene, rays, specs, v.repeats, v.ls.options(), occlusion, v.embree_isa, v.json);
   }
 }
 

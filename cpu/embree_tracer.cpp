@@ -27,6 +27,7 @@ struct EmbreeTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   double build_seconds = 0.0;
+  std::string isa;
   std::atomic<int64_t> bytes{0};
   std::mutex error_mutex;
   std::string error;  // the first message the error callback reported, if any
@@ -62,9 +63,52 @@ struct EmbreeTracer::Impl {
   }
 };
 
-EmbreeTracer::EmbreeTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+const std::vector<std::string>& embree_isa_names() {
+  // Embree 3's targets as the Debian package compiles them (rtcNewDevice("verbose=1") lists them).
+  static const std::vector<std::string> names{"best", "sse2", "sse4.2", "avx", "avx2", "avx512"};
+  return names;
+}
+
+namespace {
+
+// The widest of Embree's targets this CPU runs, as an index into embree_isa_names() (1 = sse2).
+// Embree's avx512 target is Skylake-X's set; its avx2 one also needs FMA and BMI.
+size_t host_embree_isa() {
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+    return 5;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+      __builtin_cpu_supports("bmi2"))
+    return 4;
+  if (__builtin_cpu_supports("avx")) return 3;
+  if (__builtin_cpu_supports("sse4.2")) return 2;
+  return 1;
+}
+
+size_t embree_isa_index(const std::string& isa) {
+  const std::vector<std::string>& names = embree_isa_names();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == isa) return i;
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw InputError("Embree: unknown instruction set '" + isa + "' (one of " + list + ")");
+}
+
+}  // namespace
+
+std::string embree_effective_isa(const std::string& isa) {
+  const size_t asked = embree_isa_index(isa);
+  const size_t host = host_embree_isa();
+  return embree_isa_names()[asked == 0 || asked > host ? host : asked];
+}
+
+EmbreeTracer::EmbreeTracer(const Scene& scene, const std::string& isa) : impl_(std::make_unique<Impl>()) {
   Impl& im = *impl_;
-  im.device = rtcNewDevice(nullptr);  // default configuration: all hardware threads through TBB
+  im.isa = embree_effective_isa(isa);
+  // All hardware threads through TBB; the instruction set limited where asked (Embree's "isa=").
+  const std::string config = isa == "best" ? std::string() : "isa=" + im.isa;
+  im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
   if (!im.device)
     throw InputError("Embree: cannot create a device (error code " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
   rtcSetDeviceErrorFunction(im.device, &Impl::on_error, &im);
@@ -133,6 +177,8 @@ EmbreeTracer::EmbreeTracer(const Scene& scene) : impl_(std::make_unique<Impl>())
 EmbreeTracer::~EmbreeTracer() = default;
 
 double EmbreeTracer::build_seconds() const { return impl_->build_seconds; }
+
+const std::string& EmbreeTracer::isa() const { return impl_->isa; }
 
 size_t EmbreeTracer::bytes() const {
   const int64_t b = impl_->bytes.load(std::memory_order_relaxed);

@@ -7,12 +7,25 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace ls {
 
+// The instruction sets Embree's kernels can be limited to (its `isa=` device setting), "best" first:
+// Embree's own choice, the widest of its compiled targets this CPU runs.  Our fast path is compiled
+// for one instruction set (LINESPACE_ISA: SSE2 by default), Embree picks at run time, so a ratio
+// between the two depends on which one Embree ran; `bench --embree-isa` sets it.
+const std::vector<std::string>& embree_isa_names();
+
+// What Embree runs for `isa` ("best" or one of the above) on this CPU: the requested set, or the
+// best this CPU has of Embree's targets where that is below it.
+std::string embree_effective_isa(const std::string& isa);
+
 class EmbreeTracer {
  public:
-  explicit EmbreeTracer(const Scene& scene);
+  // isa: one of embree_isa_names(); an unknown name is an InputError.
+  explicit EmbreeTracer(const Scene& scene, const std::string& isa = "best");
   ~EmbreeTracer();
   EmbreeTracer(const EmbreeTracer&) = delete;
   EmbreeTracer& operator=(const EmbreeTracer&) = delete;
@@ -23,6 +36,7 @@ class EmbreeTracer {
   void trace(const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit) const;
 
   double build_seconds() const;
+  const std::string& isa() const;  // embree_effective_isa of the constructor's isa
   size_t bytes() const;  // Embree's own memory, as reported by its memory monitor
 
  private:

@@ -33,7 +33,7 @@ void print_bench(const BenchResult& r, bool json) {
       results.push_back(j);
     }
     std::cout << nlohmann::json{{"rays", r.rays}, {"threads", r.threads}, {"repeats", r.repeats}, {"device", "cpu: " + r.cpu},
-                                {"isa", r.isa}, {"wide_width", r.wide_width}, {"any_hit", r.any_hit}, {"results", results}}
+                                {"isa", r.isa}, {"embree_isa", r.embree_isa}, {"wide_width", r.wide_width}, {"any_hit", r.any_hit}, {"results", results}}
                      .dump(2)
               << "\n";
     return;
@@ -41,7 +41,8 @@ void print_bench(const BenchResult& r, bool json) {
   std::printf("%zu rays (%s), %d threads, median of %d runs, %s\n", r.rays,
               r.any_hit ? "occlusion: fast path and Embree; any hit: reference" : "closest hit",
               r.threads, r.repeats, r.cpu.c_str());
-  std::printf("fast path: %d-wide BVH, %s; reference: the scalar single-source kernels\n", r.wide_width, r.isa.c_str());
+  std::printf("fast path: %d-wide BVH, %s; reference: the scalar single-source kernels; Embree: %s\n", r.wide_width,
+              r.isa.c_str(), r.embree_isa.c_str());
   std::printf("%-14s %10s %10s %10s %10s %9s %10s %9s %9s\n", "structure", "fast MR/s", "vs Embree", "vs bvh", "ref MR/s",
               "ref vs E", "fast/ref", "MB", "build ms");
   for (const BenchEntry& e : r.results) {
@@ -86,8 +87,8 @@ class CpuBackend : public Backend {
     return ls::render(scene, structures, options, progress);
   }
   void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs, int repeats,
-             const AccelOptions& options, bool any_hit, bool json) override {
-    print_bench(run_bench(scene, rays, specs, repeats, options, any_hit), json);
+             const AccelOptions& options, bool any_hit, const std::string& embree_isa, bool json) override {
+    print_bench(run_bench(scene, rays, specs, repeats, options, any_hit, embree_isa), json);
   }
 };
 

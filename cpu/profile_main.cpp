@@ -26,7 +26,7 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
-               "--occlusion] [--ls-min-triangles M]\n");
+               "--occlusion] [--ls-min-triangles M] [--embree-isa ISA]\n");
   return 2;
 }
 
@@ -38,6 +38,7 @@ int main(int argc, char** argv) try {
   enum class Path { Fast, Reference, Embree } path = Path::Fast;
   enum class Query { Closest, AnyHit, Occlusion } query = Query::Closest;
   ls::AccelOptions options;
+  std::string embree_isa = "best";  // valgrind 3.19 has no AVX-512: under it, "best" is Embree's avx2
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--repeat" && i + 1 < argc) repeat = std::atoi(argv[++i]);
@@ -45,6 +46,7 @@ int main(int argc, char** argv) try {
     else if (a == "--embree") path = Path::Embree;
     else if (a == "--any-hit") query = Query::AnyHit;
     else if (a == "--occlusion") query = Query::Occlusion;
+    else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
     else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
     else return usage();
   }
@@ -58,7 +60,7 @@ int main(int argc, char** argv) try {
   std::unique_ptr<ls::EmbreeTracer> embree;
   const bool any_hit = query != Query::Closest;
   if (path == Path::Embree) {
-    embree = std::make_unique<ls::EmbreeTracer>(scene);
+    embree = std::make_unique<ls::EmbreeTracer>(scene, embree_isa);
     run = [&] { embree->trace(rays.data(), hits.data(), rays.size(), any_hit); };
   } else {
     accel = ls::build_accel(scene, ls::parse_structure(argv[2]), options);
@@ -78,7 +80,7 @@ int main(int argc, char** argv) try {
   size_t blocked = 0;
   for (const lsk::Hit& h : hits) blocked += h.triangle != lsk::LS_INVALID;
   std::printf("%s, %s path: %.1f ns per ray (best of %d, one thread), %zu of %zu rays hit\n",
-              path == Path::Embree ? "embree" : argv[2],
+              path == Path::Embree ? ("embree (" + embree->isa() + ")").c_str() : argv[2],
               path == Path::Fast ? "fast" : path == Path::Reference ? "reference" : "Embree's", best / double(rays.size()) * 1e9,
               repeat, blocked, rays.size());
   return 0;

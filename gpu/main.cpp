@@ -77,7 +77,7 @@ class GpuBackend : public Backend {
   }
   // MRays/s from the median kernel time (timestamps; wall time where the queue has none).
   void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs, int repeats,
-             const AccelOptions& options, bool any_hit, bool json) override {
+             const AccelOptions& options, bool any_hit, const std::string& /*embree_isa: no Embree here*/, bool json) override {
     struct Entry {
       std::string structure;
       double mrays_per_s = 0.0;

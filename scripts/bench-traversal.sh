@@ -6,6 +6,8 @@
 #   scripts/bench-traversal.sh [SCENE ...]    default: the built-in scenes and assets/real/*.glb
 #   RUNS=3 REPEAT=3 COUNT=200000 KIND=diffuse STRUCTURES=bvh,2l-bvh,f-ls:8:6,2l-ls:4:6
 #   LS_FLAGS="--ls-min-triangles 0"           Line Space flags for every run (the paper's setting)
+#   EMBREE_ISA=best                           Embree's instruction set (bench --embree-isa; sse2 matches
+#                                             the portable build's SSE2)
 #   LINESPACE_CPU=build/release/cpu/linespace-cpu
 # Prints a Markdown table.  docs/performance.md, "Measurements".
 set -euo pipefail
@@ -17,6 +19,7 @@ COUNT=${COUNT:-200000}
 KIND=${KIND:-diffuse}
 STRUCTURES=${STRUCTURES:-bvh,2l-bvh,f-ls:8:6,2l-ls:4:6}
 LS_FLAGS=${LS_FLAGS---ls-min-triangles 0}
+EMBREE_ISA=${EMBREE_ISA:-best}
 [[ -x $BIN ]] || { echo "bench-traversal: $BIN is not built (scripts/run-demo.sh builds it)" >&2; exit 2; }
 [[ $RUNS =~ ^[1-9][0-9]*$ ]] || { echo "bench-traversal: RUNS=$RUNS is not a positive integer" >&2; exit 2; }
 scenes=("$@")
@@ -25,7 +28,7 @@ if [[ ${#scenes[@]} -eq 0 ]]; then
   for f in assets/real/*.glb; do [[ -e $f ]] && scenes+=("$f"); done
 fi
 
-echo "| scene | structure | fast MRays/s | vs Embree | fast / reference | Embree MRays/s |"
+echo "| scene | structure | fast MRays/s | vs Embree | fast / reference | Embree MRays/s (its ISA) |"
 echo "|---|---|---:|---:|---:|---:|"
 for scene in "${scenes[@]}"; do
   tmp=$(mktemp)
@@ -33,7 +36,7 @@ for scene in "${scenes[@]}"; do
     echo "  $scene: run $run of $RUNS" >&2
     # shellcheck disable=SC2086  # LS_FLAGS is a list of flags
     "$BIN" bench --scene "$scene" --kind "$KIND" --count "$COUNT" --repeat "$REPEAT" --structures "$STRUCTURES" \
-      $LS_FLAGS --json >> "$tmp"
+      --embree-isa "$EMBREE_ISA" $LS_FLAGS --json >> "$tmp"
     echo >> "$tmp"
   done
   python3 - "$scene" "$tmp" <<'EOF'
@@ -49,12 +52,13 @@ while True:
     run, at = decoder.raw_decode(text, at)
     runs.append(run)
 embree = statistics.median(next(e["mrays_per_s"] for e in r["results"] if e["structure"] == "embree") for r in runs)
+isa = runs[0]["embree_isa"]
 for name in [e["structure"] for e in runs[0]["results"] if e["structure"] != "embree"]:
     entries = [next(e for e in r["results"] if e["structure"] == name) for r in runs]
     fast = statistics.median(e["mrays_per_s"] for e in entries)
     ratio = statistics.median(e["ratio_vs_embree"] for e in entries)
     vs_ref = statistics.median(e["mrays_per_s"] / e["reference_mrays_per_s"] for e in entries)
-    print(f"| {scene} | {name} | {fast:.2f} | {ratio:.2f}x | {vs_ref:.2f}x | {embree:.2f} |")
+    print(f"| {scene} | {name} | {fast:.2f} | {ratio:.2f}x | {vs_ref:.2f}x | {embree:.2f} ({isa}) |")
 EOF
   rm -f "$tmp"
 done

@@ -2,7 +2,8 @@
 # Instructions per ray under callgrind: the table of docs/performance.md ("The profile's story").
 # Per scene, COUNT diffuse rays (seed SEED) traced on one thread by linespace-profile: each
 # structure's fast path (closest hit), bvh's reference path, bvh's occlusion query, and Embree 3's
-# rtcIntersect1 and rtcOccluded1.  Only the traversal is counted (--toggle-collect), divided by COUNT
+# rtcIntersect1 and rtcOccluded1 with its own choice of kernels (AVX2 under valgrind) and with its
+# SSE2 kernels.  Only the traversal is counted (--toggle-collect), divided by COUNT
 # and rounded down; counts do not depend on the machine's load, timings do.  JOBS callgrind runs at a time.
 #   scripts/profile-callgrind.sh [SCENE ...]   default: builtin:cornell assets/real/fireplace.glb
 #                                              builtin:generated:143000:49:1 (those that exist)
@@ -42,8 +43,12 @@ queries() {
   for s in "${structures[@]}"; do printf '%s\tls::trace_rays*\t%s %s\n' "$s" "$s" "$LS_FLAGS"; done
   printf 'bvh, reference path\tls::trace_rays*\tbvh --reference\n'
   printf 'bvh, occlusion\tls::trace_occlusion*\tbvh --occlusion\n'
+  # Embree's own choice of kernels under valgrind is its AVX2 set (valgrind 3.19 has no AVX-512);
+  # its SSE2 set is the same instruction set as the portable build's.
   printf 'Embree rtcIntersect1\tls::EmbreeTracer::trace*\tbvh --embree\n'
   printf 'Embree rtcOccluded1\tls::EmbreeTracer::trace*\tbvh --embree --occlusion\n'
+  printf 'Embree rtcIntersect1, sse2\tls::EmbreeTracer::trace*\tbvh --embree --embree-isa sse2\n'
+  printf 'Embree rtcOccluded1, sse2\tls::EmbreeTracer::trace*\tbvh --embree --occlusion --embree-isa sse2\n'
 }
 
 echo "| scene | query | instructions a ray |"

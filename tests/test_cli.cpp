@@ -1,10 +1,12 @@
 // linespace-cpu end to end: the file formats, the JSON keys of DESIGN §9, and exit status 2 with a
 // one-line reason on bad input.
+#include "embree_tracer.h"
 #include "gltf_writer.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <csignal>
@@ -164,7 +166,21 @@ TEST_CASE("bench prints DESIGN 9's JSON keys for each structure and Embree, clos
     }
     CHECK(j["results"][2]["structure"] == "embree");
     CHECK(j["results"][2]["ratio_vs_embree"].get<double>() == 1.0);
+    // Embree's own choice is reported by name: one of its targets, never "best".
+    const std::vector<std::string>& names = ls::embree_isa_names();
+    CHECK(std::find(names.begin() + 1, names.end(), j["embree_isa"].get<std::string>()) != names.end());
   }
+}
+
+TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a name Embree does not know", "[cli]") {
+  const Run r = run("bench --scene builtin:cornell --count 2000 --repeat 1 --structures bvh --embree-isa sse2");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("Embree: sse2") != std::string::npos);
+  const Run bad = run("bench --scene builtin:cornell --count 2000 --repeat 1 --structures bvh --embree-isa sse5");
+  CHECK(bad.status == 2);
+  CHECK(bad.err.find("--embree-isa") != std::string::npos);
+  CHECK(bad.out.empty());
 }
 
 TEST_CASE("render writes every image and a report", "[cli]") {

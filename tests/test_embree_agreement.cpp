@@ -218,13 +218,15 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 // The whole comparison on one scene: Embree once, each exact structure once, the given ray sets traced
 // closest-hit and as shadow segments (any-hit).
-void check_scene(const std::string& label, const ls::Scene& scene, const std::vector<ls::RayKind>& kinds, uint32_t seed) {
+// isa: Embree's instruction set (embree_tracer.h).
+void check_scene(const std::string& label, const ls::Scene& scene, const std::vector<ls::RayKind>& kinds, uint32_t seed,
+                 const std::string& isa = "best") {
   auto start = std::chrono::steady_clock::now();
-  const ls::EmbreeTracer embree(scene);
+  const ls::EmbreeTracer embree(scene, isa);
   const double embree_total = seconds_since(start);
   const ls::SurfaceLookup surfaces(scene);
   std::cout << "[embree] " << label << ": " << ls::triangle_count(scene) << " triangles, " << scene.instances.size()
-            << " instances; embree build " << embree.build_seconds() << " s (commit), " << embree_total
+            << " instances; embree (" << embree.isa() << ") build " << embree.build_seconds() << " s (commit), " << embree_total
             << " s (total), " << double(embree.bytes()) / 1e6 << " MB\n";
   REQUIRE(embree.bytes() > 0);
   REQUIRE(embree.build_seconds() > 0.0);
@@ -478,6 +480,26 @@ TEST_CASE("embree tracer: instances without triangles are skipped, ids kept", "[
 
 TEST_CASE("embree agreement: builtin:cornell", "[embree]") {
   check_scene("builtin:cornell", ls::load_scene("builtin:cornell"), {ls::RayKind::Diffuse}, 1);
+}
+
+// bench --embree-isa sse2 compares the portable build with Embree's SSE2 kernels: they must answer as
+// Embree's default ones do.
+TEST_CASE("embree agreement: builtin:cornell with Embree limited to SSE2", "[embree]") {
+  check_scene("builtin:cornell", ls::load_scene("builtin:cornell"), {ls::RayKind::Diffuse}, 1, "sse2");
+}
+
+TEST_CASE("embree instruction sets: names, this CPU's choice, limits and a refused name", "[embree]") {
+  const std::vector<std::string>& names = ls::embree_isa_names();
+  REQUIRE(names.front() == "best");
+  const std::string best = ls::embree_effective_isa("best");
+  const auto rank = [&](const std::string& isa) { return std::find(names.begin(), names.end(), isa) - names.begin(); };
+  REQUIRE(rank(best) >= 1);
+  REQUIRE(rank(best) < std::ptrdiff_t(names.size()));
+  for (size_t i = 1; i < names.size(); ++i)  // a limit is kept where this CPU has it, else the CPU's best
+    CHECK(ls::embree_effective_isa(names[i]) == (std::ptrdiff_t(i) <= rank(best) ? names[i] : best));
+  CHECK(ls::embree_effective_isa("sse2") == "sse2");  // every x86-64 CPU has it
+  CHECK_THROWS_AS(ls::embree_effective_isa("sse5"), ls::InputError);
+  CHECK_THROWS_AS(ls::EmbreeTracer(ls::load_scene("builtin:cornell"), "avx3"), ls::InputError);
 }
 
 TEST_CASE("embree agreement: builtin:instances", "[embree]") {
