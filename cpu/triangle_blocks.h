@@ -101,16 +101,18 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, Bloc
   using namespace block_lanes;
   const Float4 magnitude = xsimd::bitwise_cast<Float4>(Int4(0x7FFFFFFF));  // |x| = x & magnitude
   Float4 d[3][3];  // translated vertices: d[vertex][sheared axis]
-  Float4 abs_d[3][3];
-  for (int a = 0; a < 3; ++a) {
-    for (int k = 0; k < 3; ++k) {
+  Float4 largest[3];  // per vertex, the largest and the smallest |coordinate|: each vertex's
+  Float4 least[3];    // magnitudes die here, not after both trees (fewer registers spilled)
+  for (int k = 0; k < 3; ++k) {
+    Float4 abs_d[3];
+    for (int a = 0; a < 3; ++a) {
       d[k][a] = Float4::load_aligned(block.v[k][r.axis[a]]) - r.origin[a];
-      abs_d[k][a] = d[k][a] & magnitude;
+      abs_d[a] = d[k][a] & magnitude;
     }
+    largest[k] = glm_max(glm_max(abs_d[0], abs_d[1]), abs_d[2]);
+    least[k] = glm_min(glm_min(abs_d[0], abs_d[1]), abs_d[2]);
   }
-  const Float4 m = glm_max(glm_max(glm_max(glm_max(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),
-                                   glm_max(glm_max(abs_d[1][0], abs_d[1][1]), abs_d[1][2])),
-                           glm_max(glm_max(abs_d[2][0], abs_d[2][1]), abs_d[2][2]));
+  const Float4 m = glm_max(glm_max(largest[0], largest[1]), largest[2]);
   // unit_exponent(m) = clamp(-float_exponent(m), -126, 126), with the clamp done on m: its exponent
   // field clamped to [1, 253] is m clamped to [2^-126, 2^126] (m >= 0), two float ops where SSE2 has
   // no integer min or max.  Lanes with m == 0 end as zero edges; a NaN m (a NaN coordinate) gets
@@ -121,33 +123,43 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, Bloc
   const Float4 pow2_ks = xsimd::bitwise_cast<Float4>((Int4(254) - field) << 23);
   // A flush to zero needs a coordinate below 2^(-126 - ks); where none is, the product alone is exact.
   const Int4 one_minus_ks = Int4(1) - ks;
-  const Float4 smallest = glm_min(glm_min(glm_min(glm_min(abs_d[0][0], abs_d[0][1]), abs_d[0][2]),
-                                          glm_min(glm_min(abs_d[1][0], abs_d[1][1]), abs_d[1][2])),
-                                  glm_min(glm_min(abs_d[2][0], abs_d[2][1]), abs_d[2][2]));
+  const Float4 smallest = glm_min(glm_min(least[0], least[1]), least[2]);
   const bool may_flush = lane_bits(((xsimd::bitwise_cast<Int4>(smallest) >> 23) < one_minus_ks)) != 0u;
-  Float4 p[3][3];
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) p[k][a] = may_flush ? scale_pow2(d[k][a], one_minus_ks, pow2_ks) : d[k][a] * pow2_ks;
-  for (int a = 0; a < 3; ++a) p[0][a].store_aligned(out.a[a]);
-  Float4 sx[3];
-  Float4 sy[3];
-  for (int k = 0; k < 3; ++k) {
-    sx[k] = p[k][0] - r.shear_x * p[k][2];
-    sy[k] = p[k][1] - r.shear_y * p[k][2];
-  }
-  const Float4 eu = sx[2] * sy[1] - sy[2] * sx[1];
-  const Float4 ev = sx[0] * sy[2] - sy[0] * sx[2];
-  const Float4 ew = sx[1] * sy[0] - sy[1] * sx[0];
-  const Float4 zero(0.0f);
-  const auto any_zero = (eu == zero) || (ev == zero) || (ew == zero);
-  const auto rejected = ((eu < zero) || (ev < zero) || (ew < zero)) && ((eu > zero) || (ev > zero) || (ew > zero));
-  out.full = lane_bits(any_zero);
-  out.finish = lane_bits(!any_zero && !rejected);
-  if (out.finish != 0u) {
-    ks.store_aligned(out.ks);
-    eu.store_aligned(out.eu);
-    ev.store_aligned(out.ev);
-    ew.store_aligned(out.ew);
+  // The rest on the scaled vertices p[vertex][sheared axis]: written once, inlined into both branches
+  // below, so that p stays in registers (where the two joined, GCC stored all nine to the stack).
+  auto edges = [&](const Float4(&p)[3][3]) LS_ALWAYS_LAMBDA {
+    for (int a = 0; a < 3; ++a) p[0][a].store_aligned(out.a[a]);
+    Float4 sx[3];
+    Float4 sy[3];
+    for (int k = 0; k < 3; ++k) {
+      sx[k] = p[k][0] - r.shear_x * p[k][2];
+      sy[k] = p[k][1] - r.shear_y * p[k][2];
+    }
+    const Float4 eu = sx[2] * sy[1] - sy[2] * sx[1];
+    const Float4 ev = sx[0] * sy[2] - sy[0] * sx[2];
+    const Float4 ew = sx[1] * sy[0] - sy[1] * sx[0];
+    const Float4 zero(0.0f);
+    const auto any_zero = (eu == zero) || (ev == zero) || (ew == zero);
+    const auto rejected = ((eu < zero) || (ev < zero) || (ew < zero)) && ((eu > zero) || (ev > zero) || (ew > zero));
+    out.full = lane_bits(any_zero);
+    out.finish = lane_bits(!any_zero && !rejected);
+    if (out.finish != 0u) {
+      ks.store_aligned(out.ks);
+      eu.store_aligned(out.eu);
+      ev.store_aligned(out.ev);
+      ew.store_aligned(out.ew);
+    }
+  };
+  if (may_flush) {
+    Float4 p[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) p[k][a] = scale_pow2(d[k][a], one_minus_ks, pow2_ks);
+    edges(p);
+  } else {
+    Float4 p[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) p[k][a] = d[k][a] * pow2_ks;
+    edges(p);
   }
 }
 
