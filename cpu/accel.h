@@ -64,7 +64,8 @@ struct AccelOptions {
   LsOptions ls;
   bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
   Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
-  int wide_width = 4;                     // 4 or 8: chosen by measurement (docs/performance.md)
+  int wide_width = 4;                     // treelets (Line Space structures): 4 or 8, chosen by measurement
+  int exact_width = default_exact_width();  // the order-free walk's nodes: 4 or 8 (docs/performance.md)
   AccelOptions() = default;
   AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
 };

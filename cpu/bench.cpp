@@ -32,6 +32,7 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   result.cpu = cpu_model();
   result.isa = fast_path_isa();
   result.wide_width = options.wide_width;
+  result.exact_width = options.exact_width;
   result.any_hit = any_hit;
 
   std::vector<Accel> built;

@@ -48,11 +48,15 @@ struct LsFlags {
   bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
   std::string traversal = "fast";
   int wide_width = AccelOptions{}.wide_width;
+  int exact_width = AccelOptions{}.exact_width;
 
   void add_to(CLI::App* app) {
     app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
         ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
     app->add_option("--wide-width", wide_width, "treelet width of the fast path's ordered walk (Line Space structures): 4 or 8")
+        ->capture_default_str()->check(CLI::IsMember({4, 8}));
+    app->add_option("--exact-width", exact_width,
+                    "node width of the fast path's order-free walk (exact structures, below LS nodes): 4 or 8; default: this build's")
         ->capture_default_str()->check(CLI::IsMember({4, 8}));
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
@@ -80,6 +84,7 @@ struct LsFlags {
     o.ls.budget_rays = ls_budget_rays;
     o.traversal = parse_traversal(traversal);
     o.wide_width = wide_width;
+    o.exact_width = exact_width;
     if (progress)
       o.ls.progress = [](size_t done, size_t total) {
         std::fprintf(stderr, "\rline space: %zu/%zu LS nodes%s", done, total, done == total ? "\n" : "");

@@ -10,12 +10,11 @@
 namespace ls {
 namespace {
 
-constexpr int kWidth = ExactWideNode::kWidth;
-
+template <int kWidth>
 struct Collapser {
   const std::vector<lsk::BvhNode>& nodes;
   const std::vector<uint32_t>& node_ls;
-  ExactWideTree& tree;
+  ExactWideTree<kWidth>& tree;
 
   bool inner(uint32_t b) const { return nodes[b].count == 0; }
 
@@ -51,7 +50,7 @@ struct Collapser {
                             ? 1.0f + (half_area(nodes[n.first]) * l.cost + half_area(nodes[n.first + 1]) * r.cost) / area
                             : 1.0f + l.cost + r.cost;
     const uint32_t count = l.count + r.count;
-    if (count <= ExactWideTree::kLeafMax && kBlockCost <= split) {
+    if (count <= ExactWideTree<kWidth>::kLeafMax && kBlockCost <= split) {
       merge[b] = 1;
       return Sah{kBlockCost, count};
     }
@@ -125,7 +124,7 @@ struct Collapser {
     std::array<uint32_t, kWidth> lanes;
     const int n = children(b, lanes);
     const uint32_t index = uint32_t(tree.nodes.size());
-    ExactWideNode w;
+    ExactWideNode<kWidth> w;
     std::memset(&w, 0, sizeof(w));
     for (int i = 0; i < kWidth; ++i) {  // unused lanes: a NaN box, which no ray enters (fast_tracer.cpp)
       w.child[i] = lsk::LS_INVALID;
@@ -155,11 +154,12 @@ struct Collapser {
 
 }  // namespace
 
-ExactWideTree build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                                    const std::vector<uint32_t>& roots) {
-  ExactWideTree tree;
+template <int W>
+ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
+                                       const std::vector<uint32_t>& roots) {
+  ExactWideTree<W> tree;
   tree.entry_of.assign(nodes.size(), lsk::LS_INVALID);
-  Collapser c{nodes, node_ls, tree, {}, {}};
+  Collapser<W> c{nodes, node_ls, tree, {}, {}};
   std::vector<uint32_t> entries;
   if (!node_ls.empty()) {
     c.has_ls.assign(nodes.size(), 0);
@@ -180,5 +180,10 @@ ExactWideTree build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, cons
     }
   return tree;
 }
+
+template ExactWideTree<4> build_exact_wide_tree<4>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
+                                                   const std::vector<uint32_t>&);
+template ExactWideTree<8> build_exact_wide_tree<8>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
+                                                   const std::vector<uint32_t>&);
 
 }  // namespace ls

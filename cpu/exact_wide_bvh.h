@@ -1,5 +1,6 @@
-// The wide BVH of the fast path's order-free walk: 4-wide nodes that hold only their children's boxes
-// (SoA, 128 bytes a node, like Embree's), traversed nearest child first.
+// The wide BVH of the fast path's order-free walk: 4- or 8-wide nodes that hold only their children's
+// boxes (SoA, 128 or 256 bytes a node, like Embree's), traversed nearest child first.  The width is
+// the build's choice (default_exact_width(), fast_tracer.h) or --exact-width.
 //
 // Why it may ignore the reference's visiting order: a closest-hit query's answer does not depend on
 // it (the smaller t wins, ties go to the lower (instance, triangle): common/kernels/hit.h), and the
@@ -11,8 +12,8 @@
 // Entries: the order-free walk starts at the *entry* nodes of a binary BVH, the topmost inner nodes
 // with no Line Space node strictly below them: the root of an exact structure, each Line Space node
 // (its subtree, when a lookup is refused), and the Line-Space-free subtrees between them.  Each entry
-// is collapsed on its own into wide nodes by opening, while fewer than 4 children, the child of
-// largest surface area.  A subtree of at most kLeafMax primitives becomes one leaf: four triangles
+// is collapsed on its own into wide nodes by opening, while fewer children than the width, the child
+// of largest surface area.  A subtree of at most kLeafMax primitives becomes one leaf: four triangles
 // cost one SIMD test whether they sit in one binary leaf or in three, and a level less is a load less.
 #pragma once
 
@@ -24,27 +25,33 @@
 
 namespace ls {
 
+template <int W>
 struct alignas(64) ExactWideNode {
-  static constexpr int kWidth = 4;
+  static constexpr int kWidth = W;
   float lo[3][kWidth];  // per axis, per child: its box (NaN in an unused lane)
   float hi[3][kWidth];
   uint32_t child[kWidth];  // inner: wide node; leaf: its first primitive (triangle trees: its first
                            // block lane, see triangle_blocks.h); unused lane: LS_INVALID
   uint32_t count[kWidth];  // leaf: primitive count; 0: inner node or unused lane
 };
-static_assert(sizeof(ExactWideNode) == 128, "two cache lines, like Embree's 4-wide node");
+static_assert(sizeof(ExactWideNode<4>) == 128, "two cache lines, like Embree's 4-wide node");
+static_assert(sizeof(ExactWideNode<8>) == 256, "four cache lines, like Embree's 8-wide node");
 
 // One collapsed BVH array (the flat BVH, all object BVHs of a 2L structure, or its top level).
+template <int W>
 struct ExactWideTree {
-  static constexpr uint32_t kLeafMax = 4;
-  std::vector<ExactWideNode> nodes;
+  using Node = ExactWideNode<W>;
+  static constexpr uint32_t kLeafMax = 4;  // one triangle block
+  std::vector<Node> nodes;
   std::vector<uint32_t> entry_of;  // per binary node: the wide node of the entry rooted there, or LS_INVALID
   size_t entries = 0;
-  size_t bytes() const { return nodes.size() * sizeof(ExactWideNode) + entry_of.size() * sizeof(uint32_t); }
+  size_t bytes() const { return nodes.size() * sizeof(Node) + entry_of.size() * sizeof(uint32_t); }
 };
 
-// Collapses the entries below each of `roots`.  node_ls may be empty (no Line Space).
-ExactWideTree build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                                    const std::vector<uint32_t>& roots);
+// Collapses the entries below each of `roots` into W-wide nodes (W = 4 or 8).  node_ls may be empty
+// (no Line Space).
+template <int W>
+ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
+                                       const std::vector<uint32_t>& roots);
 
 }  // namespace ls

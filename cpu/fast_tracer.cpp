@@ -8,6 +8,7 @@
 
 #include <bit>
 #include <cstddef>
+#include <type_traits>
 
 namespace ls {
 
@@ -32,6 +33,11 @@ const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" :
 std::string fast_path_isa() {
   return std::string(SimdArch::name()) + " (" + std::to_string(FloatBatch::size) + " floats)";
 }
+
+// 8-wide where the box tests run 8 floats at once (AVX builds): faster than 4-wide on nearly every
+// scene there.  With SSE2 an 8-wide node takes two batches and runs more instructions a ray than
+// 4-wide on the larger scenes, so 4 there (docs/performance.md, "The order-free tree's width").
+int default_exact_width() { return FloatBatch::size >= 8 ? 8 : 4; }
 
 namespace {
 
@@ -245,31 +251,44 @@ inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray
   }
 }
 
-using ExactBoxRay = SlabRay<Float4>;
+// The batch an exact W-wide node's boxes are tested in: 4 floats, or 8 where the build has AVX and
+// W = 8 (an 8-wide node on SSE2 takes two batches).
+template <int W>
+using ExactBatch = std::conditional_t<W == 8, FloatBatch, Float4>;
+template <int W>
+using ExactBoxRay = SlabRay<ExactBatch<W>>;
 
-// ray_box on the four children of an exact wide node against [tmin, tmax]: the lanes hit (bit l) and
+// ray_box on the children of an exact wide node against [tmin, tmax]: the lanes hit (bit l) and
 // their entry distances.  An unused lane's box is NaN, which no ray enters: its entry distance is
 // NaN on an axis the ray crosses (glm_max keeps a NaN first operand) and +big on one it runs along.
-template <bool kParallel>
-LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode& node, const ExactBoxRay& r, const Float4& tmin, float tmax,
-                                          float* tnear) {
-  Float4 near;
-  Float4 widened;
-  slab_tests<true, kParallel>(reinterpret_cast<const char*>(&node), r, tmin, Float4(tmax), near, widened);
-  near.store_aligned(tnear);
-  return lane_bits(near <= widened);
+template <bool kParallel, int W>
+LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode<W>& node, const ExactBoxRay<W>& r, const ExactBatch<W>& tmin,
+                                          float tmax, float* tnear) {
+  using Batch = ExactBatch<W>;
+  unsigned bits = 0;
+  const Batch tmax_batch(tmax);
+  for (int c = 0; c < W; c += int(Batch::size)) {
+    Batch near;
+    Batch widened;
+    slab_tests<true, kParallel>(reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c), r, tmin, tmax_batch, near,
+                                widened);
+    near.store_aligned(tnear + c);
+    bits |= lane_bits(near <= widened) << c;
+  }
+  return bits;
 }
 
 // The order-free closest-hit walk below an exact wide node (whose binary node's box the caller has
 // tested): nearest child first, a pending child popped only while its entry distance can still hold
 // something as close as the current hit, as in the reference.
+template <int W>
 struct ExactWalk {
   struct Pending {
     uint child;
     uint count;
     float t;
   };
-  static constexpr int kStack = 4 * lsk::TraceContext::LS_STACK_SIZE;  // <= 3 more per wide level
+  static constexpr int kStack = W * lsk::TraceContext::LS_STACK_SIZE;  // < W more per wide level
   uint child = 0;  // what the next step visits: a wide node (count 0) or a leaf
   uint count = 0;
   int sp = 0;
@@ -299,14 +318,14 @@ struct ExactWalk {
   // running hit and returns true to end the walk there (an occlusion query's first hit).  When the
   // boxes admit several children, all of them start loading at once.  False when the walk is over.
   template <bool kParallel, class LeafFn, class PrefetchFn>
-  LS_ALWAYS_INLINE bool step(const ExactWideTree& tree, const ExactBoxRay& ray, const Float4& tmin, const Hit& hit,
+  LS_ALWAYS_INLINE bool step(const ExactWideTree<W>& tree, const ExactBoxRay<W>& ray, const ExactBatch<W>& tmin, const Hit& hit,
                              LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
     if (count != 0u) {
       if (leaf(child, count)) return false;  // the query stops at this leaf
       return pop(hit.t);
     }
-    const ExactWideNode& node = tree.nodes[child];
-    alignas(16) float tn[4];
+    const ExactWideNode<W>& node = tree.nodes[child];
+    alignas(32) float tn[W];
     unsigned lanes = exact_box_tests<kParallel>(node, ray, tmin, hit.t, tn);
     if (lanes == 0u) return pop(hit.t);
     unsigned near = unsigned(std::countr_zero(lanes));
@@ -320,8 +339,7 @@ struct ExactWalk {
       stack[sp++] = Pending{node.child[l], node.count[l], tn[l]};
       if (node.count[l] == 0u) {
         const char* p = reinterpret_cast<const char*>(&tree.nodes[node.child[l]]);
-        __builtin_prefetch(p);
-        __builtin_prefetch(p + 64);
+        for (size_t line = 0; line < sizeof(ExactWideNode<W>); line += 64) __builtin_prefetch(p + line);
       } else {
         prefetch_leaf(node.child[l]);
       }
@@ -332,7 +350,7 @@ struct ExactWalk {
     if (lanes == 0u) {  // two: push the farther, go on with the nearer
       push(other);
     } else {  // three or four: push them farthest first, go on with the nearest
-      unsigned order[4] = {near, other, 0u, 0u};
+      unsigned order[W] = {near, other};
       unsigned n = 2;
       for (; lanes != 0u; lanes &= lanes - 1u) {
         unsigned l = unsigned(std::countr_zero(lanes));
@@ -353,32 +371,33 @@ struct ExactWalk {
 };
 
 // One ray's whole order-free walk below `entry`.
-template <class LeafFn, class PrefetchFn>
-inline void walk_exact(const ExactWideTree& tree, uint entry, const ExactBoxRay& ray, float tmin, const Hit& hit,
+template <int W, class LeafFn, class PrefetchFn>
+inline void walk_exact(const ExactWideTree<W>& tree, uint entry, const ExactBoxRay<W>& ray, float tmin, const Hit& hit,
                        LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
   if (hit.t != hit.t) return;  // a NaN tmax: no t is <= it, the reference finds nothing either
-  const Float4 tmin4(tmin);
-  ExactWalk walk;
+  const ExactBatch<W> tmin_batch(tmin);
+  ExactWalk<W> walk;
   walk.start(entry);
   if (ray.any_parallel)  // rays parallel to a slab are rare: the others run straight-line box tests
-    while (walk.step<true>(tree, ray, tmin4, hit, leaf, prefetch_leaf)) {
+    while (walk.template step<true>(tree, ray, tmin_batch, hit, leaf, prefetch_leaf)) {
     }
   else
-    while (walk.step<false>(tree, ray, tmin4, hit, leaf, prefetch_leaf)) {
+    while (walk.template step<false>(tree, ray, tmin_batch, hit, leaf, prefetch_leaf)) {
     }
 }
 
 // What the fast path keeps of the object level: the treelets and the exact wide tree of the object
 // BVHs (or of the flat BVH) and the triangle blocks.  Shared by the tracers of every top level
 // (animation).
-template <int K>
+template <int K, int W>
 struct ObjectPart {
   TriangleBlocks blocks;
-  ExactWideTree exact;
+  ExactWideTree<W> exact;
   WideTree<K> tree;
 };
 
-template <int K>
+// K: the treelets' binary levels (4 or 8 wide); W: the exact wide tree's width (4 or 8).
+template <int K, int W>
 class WideTracer final : public FastTracer {
  public:
   // Only Line Space structures get treelets (their lookups need the reference's order).  An exact
@@ -387,9 +406,9 @@ class WideTracer final : public FastTracer {
   WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()), ordered_(accel.spec.line_space()) {
     const std::vector<uint32_t> none;
     const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
-    auto part = std::make_shared<ObjectPart<K>>();
+    auto part = std::make_shared<ObjectPart<K, W>>();
     const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
-    part->exact = build_exact_wide_tree(accel.nodes, node_ls, roots);
+    part->exact = build_exact_wide_tree<W>(accel.nodes, node_ls, roots);
     part->blocks = build_triangle_blocks(accel.nodes, accel.tris, part->exact);
     if (ordered_) part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.lane_of, part->exact.entry_of);
     if (two_level_) build_top(accel);
@@ -454,12 +473,13 @@ class WideTracer final : public FastTracer {
     return part_->tree.bytes() + part_->exact.bytes() + part_->blocks.bytes() + top_.bytes() + top_exact_.bytes();
   }
   int width() const override { return 1 << K; }
+  int exact_width() const override { return W; }
 
  private:
   // The top level: the exact wide tree, whose leaf lanes hold their first instance, and for Line
   // Space structures the treelets.
   void build_top(const Accel& accel) {
-    top_exact_ = build_exact_wide_tree(accel.top_nodes, {}, {0u});
+    top_exact_ = build_exact_wide_tree<W>(accel.top_nodes, {}, {0u});
     if (ordered_) top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
   }
 
@@ -505,14 +525,14 @@ class WideTracer final : public FastTracer {
       }
       return tri_ray_made;
     };
-    ExactBoxRay exact_ray;  // made once, at the first order-free walk
+    ExactBoxRay<W> exact_ray;  // made once, at the first order-free walk
     bool exact_ray_made = false;
     // Inlined where an exact structure or an instance's object starts with it (2l-bvh on cornell
     // 3,781 -> 3,611 instructions a ray); a call from the treelet walk, which inlined it there
     // outgrew GCC's budget (f-ls:8:6 on cornell 2,818 -> 3,045).
     auto exact = [&](uint entry) LS_ALWAYS_LAMBDA {  // true: an occlusion query's hit
       if (!exact_ray_made) {
-        init_slab_ray<Float4, ExactWideNode>(exact_ray, origin, inv_dir, true);  // in place: no copy
+        init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);  // in place: no copy
         exact_ray_made = true;
       }
       bool stopped = false;
@@ -590,7 +610,7 @@ class WideTracer final : public FastTracer {
       instances(root.first, root.count);
     else if (q != Query::AnyHit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no decision depends on the order
       [&]() __attribute__((noinline)) {  // its own function, with the instances' walks inlined in it (fewer spills)
-        walk_exact(top_exact_, top_exact_.entry_of[0], make_slab_ray<Float4, ExactWideNode>(ray.origin, inv_dir, true), ray.tmin,
+        walk_exact(top_exact_, top_exact_.entry_of[0], make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir, true), ray.tmin,
                    hit, instances, [](uint) {});
       }();
     else
@@ -611,18 +631,23 @@ class WideTracer final : public FastTracer {
 
   bool two_level_;
   bool ordered_;  // a Line Space structure: treelets for the reference's order
-  std::shared_ptr<const ObjectPart<K>> part_;
+  std::shared_ptr<const ObjectPart<K, W>> part_;
   const TriBlock* blocks_ = nullptr;  // part_->blocks.blocks.data(): one load less on the hot path
   WideTree<K> top_;
-  ExactWideTree top_exact_;
+  ExactWideTree<W> top_exact_;
 };
 
 }  // namespace
 
-std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width) {
-  if (width == 8) return std::make_shared<WideTracer<3>>(accel);
-  if (width == 4) return std::make_shared<WideTracer<2>>(accel);
-  throw InputError("wide BVH width must be 4 or 8, not " + std::to_string(width));
+std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width, int exact_width) {
+  if (width != 4 && width != 8) throw InputError("wide BVH width must be 4 or 8, not " + std::to_string(width));
+  if (exact_width != 4 && exact_width != 8)
+    throw InputError("exact wide BVH width must be 4 or 8, not " + std::to_string(exact_width));
+  if (width == 8)
+    return exact_width == 8 ? std::shared_ptr<const FastTracer>(std::make_shared<WideTracer<3, 8>>(accel))
+                            : std::make_shared<WideTracer<3, 4>>(accel);
+  return exact_width == 8 ? std::shared_ptr<const FastTracer>(std::make_shared<WideTracer<2, 8>>(accel))
+                          : std::make_shared<WideTracer<2, 4>>(accel);
 }
 
 }  // namespace ls

@@ -1,7 +1,7 @@
 // The fast CPU path beside the scalar single-source reference (common/kernels/traverse_bvh.h), with
 // SIMD box and triangle tests (xsimd).  It gives the reference's answers bit for bit, by two walks:
-//  - closest-hit queries below any node with no Line Space under it walk an order-free 4-wide BVH
-//    (exact_wide_bvh.h), since the closest hit does not depend on the visiting order;
+//  - closest-hit queries below any node with no Line Space under it walk an order-free 4- or 8-wide
+//    BVH (exact_wide_bvh.h), since the closest hit does not depend on the visiting order;
 //  - Line Space structures walk treelets (wide_bvh.h) in the reference's own order, since a lookup's
 //    answer does, and call the shared kernels (ls_lookup, instance_ray) at the same moments.
 // Triangles are tested four at a time (triangle_blocks.h) with the kernel's arithmetic, so hits, t, u,
@@ -45,7 +45,8 @@ class FastTracer {
   virtual void find_candidates(lsk::TraceContext& context, const lsk::LsNode& ls, const lsk::vec3* centres, uint32_t first,
                                uint32_t end, uint32_t further_rays, uint32_t instance, uint32_t* prims) const = 0;
   virtual size_t bytes() const = 0;  // the wide nodes and their index
-  virtual int width() const = 0;     // 4 or 8
+  virtual int width() const = 0;        // the treelets': 4 or 8
+  virtual int exact_width() const = 0;  // the order-free walk's nodes: 4 or 8
   // A tracer for the same Accel after its top level was rebuilt or refitted (top_level_update.h):
   // the wide top tree is collapsed anew, the object wide trees and triangle blocks are shared, not
   // copied.  Flat structures have no top level: the tracer is returned as it is.
@@ -54,8 +55,12 @@ class FastTracer {
   virtual const void* object_part() const = 0;
 };
 
-// width: 4 (treelets of 2 levels) or 8 (3 levels).  The Accel's arrays must stay where they are.
-std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width);
+// width: 4 (treelets of 2 levels) or 8 (3 levels); exact_width: the order-free walk's nodes, 4 or 8.
+// Other widths are an InputError.  The Accel's arrays must stay where they are.
+std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width, int exact_width);
+
+// The exact wide tree's width this build picks: 8 where its box tests run 8 floats (AVX), else 4.
+int default_exact_width();
 
 // The SIMD instruction set the fast path was compiled for, e.g. "sse2 (4 floats)".
 std::string fast_path_isa();

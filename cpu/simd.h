@@ -63,4 +63,9 @@ inline unsigned lane_bits(const xsimd::batch_bool<int32_t, Simd4Arch>& b) {
 #endif
 }
 
+#if XSIMD_WITH_AVX
+// Bit l set when lane l of an 8-lane AVX mask is true.
+inline unsigned lane_bits(const xsimd::batch_bool<float, xsimd::avx>& b) { return unsigned(_mm256_movemask_ps(b)); }
+#endif
+
 }  // namespace ls

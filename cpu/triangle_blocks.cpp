@@ -6,16 +6,17 @@
 
 namespace ls {
 
+template <int W>
 TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, const std::vector<lsk::Triangle>& tris,
-                                     ExactWideTree& exact) {
+                                     ExactWideTree<W>& exact) {
   struct Range {
     uint32_t first;
     uint32_t count;
   };
   std::vector<Range> ranges;  // each gets blocks of its own, lanes past its end unused
   std::vector<uint32_t*> exact_children;
-  for (ExactWideNode& node : exact.nodes)
-    for (int l = 0; l < ExactWideNode::kWidth; ++l)
+  for (ExactWideNode<W>& node : exact.nodes)
+    for (int l = 0; l < W; ++l)
       if (node.count[l] > 0) {
         ranges.push_back(Range{node.child[l], node.count[l]});
         exact_children.push_back(&node.child[l]);
@@ -58,5 +59,10 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
   });
   return out;
 }
+
+template TriangleBlocks build_triangle_blocks<4>(const std::vector<lsk::BvhNode>&, const std::vector<lsk::Triangle>&,
+                                                 ExactWideTree<4>&);
+template TriangleBlocks build_triangle_blocks<8>(const std::vector<lsk::BvhNode>&, const std::vector<lsk::Triangle>&,
+                                                 ExactWideTree<8>&);
 
 }  // namespace ls

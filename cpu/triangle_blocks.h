@@ -38,9 +38,11 @@ struct TriangleBlocks {
   size_t bytes() const { return blocks.size() * sizeof(TriBlock) + lane_of.size() * sizeof(uint32_t); }
 };
 
+template <int W>
 struct ExactWideTree;
+template <int W>  // 4 or 8
 TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, const std::vector<lsk::Triangle>& tris,
-                                     ExactWideTree& exact);
+                                     ExactWideTree<W>& exact);
 
 namespace block_lanes {
 

@@ -1,6 +1,7 @@
 // The fast CPU path (cpu/fast_tracer.h: wide SIMD BVH, four-lane triangle filter) against the scalar
 // reference kernels: every hit record bit for bit (t, u, v, ids) and the Line Space counters, for
-// closest and any hit, on the built-in scenes and random ones, every structure, both widths.
+// closest and any hit, on the built-in scenes and random ones, every structure, both widths (of the
+// treelets and of the order-free tree).
 #include "accel.h"
 #include "exact_wide_bvh.h"
 #include "triangle_blocks.h"
@@ -49,7 +50,8 @@ std::string describe(const lsk::LsCounters& c) {
 // Runs both paths on the same rays and requires identical hit records and counters; returns the
 // number of Line Space lookups.
 size_t require_same(const ls::Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, const std::string& what) {
-  INFO(what << ", " << accel.spec.name() << ", " << accel.fast->width() << "-wide, " << (any_hit ? "any hit" : "closest hit"));
+  INFO(what << ", " << accel.spec.name() << ", " << accel.fast->width() << "-wide treelets, " << accel.fast->exact_width()
+            << "-wide order-free tree, " << (any_hit ? "any hit" : "closest hit"));
   std::vector<lsk::Hit> ref(rays.size()), fast(rays.size());
   lsk::LsCounters ref_counters{}, fast_counters{};
   ls::trace_rays(accel, rays.data(), ref.data(), rays.size(), any_hit, &ref_counters, ls::Traversal::Reference);
@@ -72,9 +74,11 @@ size_t require_same(const ls::Accel& accel, const std::vector<lsk::Ray>& rays, b
   return ref_counters.lookups;
 }
 
-ls::AccelOptions options(int width, float angle = 45.0f, uint32_t min_triangles = 0) {
+// width: the treelets' and the order-free tree's, unless exact_width names the latter.
+ls::AccelOptions options(int width, float angle = 45.0f, uint32_t min_triangles = 0, int exact_width = 0) {
   ls::AccelOptions o;
   o.wide_width = width;
+  o.exact_width = exact_width != 0 ? exact_width : width;
   o.ls.angle_degrees = angle;
   o.ls.min_triangles = min_triangles;
   return o;
@@ -91,6 +95,7 @@ void check_scene(const ls::Scene& scene, const std::string& name, const std::vec
       const ls::Accel accel = ls::build_accel(scene, ls::parse_structure(s), options(width));
       REQUIRE(accel.fast);
       REQUIRE(accel.fast->width() == width);
+      REQUIRE(accel.fast->exact_width() == width);
       size_t lookups = 0;
       for (const auto& [kind, rays] : sets) {
         lookups += require_same(accel, rays, kind == "shadow", name + ", " + kind + " rays");
@@ -231,9 +236,10 @@ TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degen
   rays.push_back(ray(glm::vec3(0.0f), glm::vec3(0.0f)));                     // zero direction
   rays.push_back(ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.0f, 0.0f), 2.0f, 1.0f));  // empty interval
   rays.push_back(ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.2f, 0.1f), 0.0f, std::numeric_limits<float>::quiet_NaN()));
-  for (int width : {4, 8})
+  for (const auto& [width, exact_width] : {std::pair{4, 4}, {8, 8}, {4, 8}, {8, 4}})
     for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
-      const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width));
+      const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width, 45.0f, 0u, exact_width));
+      REQUIRE(a.fast->exact_width() == exact_width);
       require_same(a, rays, false, "special rays");
       require_same(a, rays, true, "special rays");
     }
@@ -245,12 +251,18 @@ TEST_CASE("wide BVH: trace_rays takes the fast path by default and the reference
   CHECK(fast.traversal == ls::Traversal::Fast);
   CHECK(fast.fast != nullptr);
   CHECK(fast.bytes_wide() > 0);
+  CHECK(fast.fast->width() == 4);
+  CHECK(fast.fast->exact_width() == ls::default_exact_width());
+  CHECK((ls::default_exact_width() == 4 || ls::default_exact_width() == 8));
   ls::AccelOptions o;
   o.traversal = ls::parse_traversal("reference");
   const ls::Accel ref = ls::build_accel(scene, ls::parse_structure("f-ls:4:3"), o);
   CHECK(ref.traversal == ls::Traversal::Reference);
   CHECK_THROWS_AS(ls::parse_traversal("simd"), ls::InputError);
   o.wide_width = 16;
+  CHECK_THROWS_AS(ls::build_accel(scene, ls::parse_structure("bvh"), o), ls::InputError);
+  o.wide_width = 4;
+  o.exact_width = 2;
   CHECK_THROWS_AS(ls::build_accel(scene, ls::parse_structure("bvh"), o), ls::InputError);
 }
 
@@ -417,15 +429,16 @@ TEST_CASE("triangle blocks: every lane gives the scalar kernel's hit, from denor
   CHECK(hits > 500);  // enough lanes pass the edge test to exercise the deciding half
 }
 
-TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
+template <int W>
+void check_exact_tree() {
   const ls::Scene scene = random_scene(8);
   for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3", "2l-ls:0:3"}) {
-    INFO(s);
+    INFO(s << ", " << W << "-wide");
     const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
     const std::vector<uint32_t> none;
     const std::vector<uint32_t>& node_ls = a.spec.line_space() ? a.node_ls : none;
     const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
-    const ls::ExactWideTree tree = ls::build_exact_wide_tree(a.nodes, node_ls, roots);
+    const ls::ExactWideTree<W> tree = ls::build_exact_wide_tree<W>(a.nodes, node_ls, roots);
     // The entries are the topmost inner nodes with no Line Space node strictly below them.
     std::function<bool(uint32_t)> holds_ls = [&](uint32_t b) {
       if (!node_ls.empty() && node_ls[b] != lsk::LS_INVALID) return true;
@@ -465,23 +478,25 @@ TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
           return a.nodes[c].count > 0 ? a.nodes[c].count : range_count(a.nodes[c].first) + range_count(a.nodes[c].first + 1);
         };
         std::map<uint32_t, int> seen;
-        size_t outside = 0, unused_not_nan = 0, narrow = 0, big_merged = 0;
+        size_t outside = 0, unused_not_nan = 0, narrow = 0, underfilled = 0, big_merged = 0;
         std::function<void(uint32_t)> visit = [&](uint32_t w) {
-          const ls::ExactWideNode& node = tree.nodes[w];
+          const ls::ExactWideNode<W>& node = tree.nodes[w];
           int used = 0;
-          for (int l = 0; l < ls::ExactWideNode::kWidth; ++l) {
+          int inner = 0;
+          for (int l = 0; l < W; ++l) {
             if (node.child[l] == lsk::LS_INVALID) {
               unused_not_nan += !std::isnan(node.lo[0][l]) || !std::isnan(node.hi[2][l]);
               continue;
             }
             ++used;
             if (node.count[l] == 0) {
+              ++inner;
               visit(node.child[l]);
               continue;
             }
             bool binary_leaf = false;  // a leaf lane is a binary leaf or a merged subtree of <= kLeafMax
             for (const lsk::BvhNode& n : a.nodes) binary_leaf |= n.count == node.count[l] && n.first == node.child[l];
-            big_merged += !binary_leaf && node.count[l] > ls::ExactWideTree::kLeafMax;
+            big_merged += !binary_leaf && node.count[l] > ls::ExactWideTree<W>::kLeafMax;
             for (uint32_t k = 0; k < node.count[l]; ++k) {
               const uint32_t i = node.child[l] + k;
               ++seen[i];
@@ -490,11 +505,13 @@ TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
             }
           }
           narrow += used < 2;
+          underfilled += used < W && inner > 0;  // the collapse opens inner children while it has room
         };
         visit(tree.entry_of[b]);
         CHECK(outside == 0);
         CHECK(unused_not_nan == 0);
         CHECK(narrow == 0);
+        CHECK(underfilled == 0);
         CHECK(big_merged == 0);
         CHECK(seen.size() == range_count(b));
         size_t repeated = 0;
@@ -504,6 +521,11 @@ TEST_CASE("exact wide tree: entries, leaves and boxes", "[wide]") {
       check_entry(r);
     }
   }
+}
+
+TEST_CASE("exact wide tree: entries, leaves and boxes, 4 and 8 wide", "[wide]") {
+  check_exact_tree<4>();
+  check_exact_tree<8>();
 }
 
 TEST_CASE("wide BVH: the candidate search on the fast path stores the reference kernel's candidates, every shaft", "[wide]") {
