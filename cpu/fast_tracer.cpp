@@ -372,7 +372,7 @@ struct ExactWalk {
 
 // One ray's whole order-free walk below `entry`.
 template <int W, class LeafFn, class PrefetchFn>
-inline void walk_exact(const ExactWideTree<W>& tree, uint entry, const ExactBoxRay<W>& ray, float tmin, const Hit& hit,
+LS_ALWAYS_INLINE void walk_exact(const ExactWideTree<W>& tree, uint entry, const ExactBoxRay<W>& ray, float tmin, const Hit& hit,
                        LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
   if (hit.t != hit.t) return;  // a NaN tmax: no t is <= it, the reference finds nothing either
   const ExactBatch<W> tmin_batch(tmin);
@@ -506,6 +506,57 @@ class WideTracer final : public FastTracer {
   // the LS build's search gets its own copy of the walks it inlines; sharing them added a caller
   // to the instance's exact walk, which GCC then left out of line (2l-bvh on generated 3,388 ->
   // 3,483).
+  // The ray's BlockRay, made when first asked: many rays that enter an instance's box never reach
+  // a triangle of it.
+  struct LazyBlockRay {
+    const vec3& origin;
+    const vec3& dir;
+    BlockRay made;  // not zeroed first: that cost 40 instructions a ray
+    bool ready = false;
+    LazyBlockRay(const vec3& o, const vec3& d) : origin(o), dir(d) {}
+    LS_ALWAYS_INLINE const BlockRay& operator()() {
+      if (!ready) {
+        made.tri = lsk::make_tri_ray(origin, dir);
+        broadcast_block_ray(made);
+        ready = true;
+      }
+      return made;
+    }
+  };
+
+  // The order-free walk below `entry`, leaves tested against tri_ray().  True: an occlusion query's hit.
+  LS_ALWAYS_INLINE bool run_exact(lsk::TraceContext& c, uint entry, const ExactBoxRay<W>& exact_ray, LazyBlockRay& tri_ray,
+                                  float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
+    bool stopped = false;
+    auto run = [&](auto&& ray_for_leaf) LS_ALWAYS_LAMBDA {
+      walk_exact(
+          part_->exact, entry, exact_ray, tmin, hit,
+          [&](uint lane, uint n) {
+            return stopped = trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, any_hit, hit, hit_prim);
+          },
+          [&](uint lane) { prefetch_block(lane / 4u); });
+    };
+    if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
+      const BlockRay& tr = tri_ray();
+      run([&]() -> const BlockRay& { return tr; });
+    } else {  // an instance's object: many walks end before any leaf
+      run(tri_ray);
+    }
+    return stopped;
+  }
+
+  // A query that is one order-free walk from the entry at the root (the entry's node tests the
+  // root's children, which pass only where the root would): an exact structure's, or an instance's
+  // object without a Line Space at its root.  Kept apart from the treelet walk's closures, which
+  // cost about 50 stores a ray before any box is tested.
+  LS_ALWAYS_INLINE bool trace_entry(lsk::TraceContext& c, uint entry, const vec3& origin, const vec3& dir, const vec3& inv_dir,
+                                    float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
+    ExactBoxRay<W> exact_ray;
+    init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);
+    LazyBlockRay tri_ray{origin, dir};
+    return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
+  }
+
   template <bool kSearch = false>
   LS_ALWAYS_INLINE bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin,
                                   uint instance, Query q, bool use_ls, Hit& hit, uint& hit_prim) const {
@@ -514,49 +565,21 @@ class WideTracer final : public FastTracer {
     if (!order_free && !ordered_)  // no treelets: the reference kernel (e.g. an object ray that overflowed)
       return trace_bvh_reference(c, root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
-    // Made when first needed: many rays that enter an instance's box never reach a triangle of it.
-    BlockRay tri_ray_made;
-    bool tri_ray_ready = false;
-    auto tri_ray = [&]() LS_ALWAYS_LAMBDA -> const BlockRay& {
-      if (!tri_ray_ready) {
-        tri_ray_made.tri = lsk::make_tri_ray(origin, dir);
-        broadcast_block_ray(tri_ray_made);
-        tri_ray_ready = true;
-      }
-      return tri_ray_made;
-    };
+    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
+    const uint root_entry = part_->exact.entry_of[root];
+    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID)
+      return trace_entry(c, root_entry, origin, dir, inv_dir, tmin, instance, any_hit, hit, hit_prim);
+    LazyBlockRay tri_ray{origin, dir};
     ExactBoxRay<W> exact_ray;  // made once, at the first order-free walk
     bool exact_ray_made = false;
-    // Inlined where an exact structure or an instance's object starts with it (2l-bvh on cornell
-    // 3,781 -> 3,611 instructions a ray); a call from the treelet walk, which inlined it there
-    // outgrew GCC's budget (f-ls:8:6 on cornell 2,818 -> 3,045).
     auto exact = [&](uint entry) LS_ALWAYS_LAMBDA {  // true: an occlusion query's hit
       if (!exact_ray_made) {
         init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);  // in place: no copy
         exact_ray_made = true;
       }
-      bool stopped = false;
-      auto run = [&](auto&& ray_for_leaf) {
-        walk_exact(
-            part_->exact, entry, exact_ray, tmin, hit,
-            [&](uint lane, uint n) {
-              return stopped = trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, any_hit, hit, hit_prim);
-            },
-            [&](uint lane) { prefetch_block(lane / 4u); });
-      };
-      if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
-        const BlockRay& tr = tri_ray();
-        run([&]() -> const BlockRay& { return tr; });
-      } else {  // an instance's object: many walks end before any leaf
-        run(tri_ray);
-      }
-      return stopped;
+      return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
     };
     auto exact_call = [&](uint entry) __attribute__((noinline)) { return exact(entry); };
-    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
-    const uint root_entry = part_->exact.entry_of[root];
-    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID)
-      return exact(root_entry);  // the entry's node tests the root's children, which pass only where the root would
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
     auto visit = [&](uint ls, bool leaf, uint, uint count, uint tri_lane, uint entry) {
