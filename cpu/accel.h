@@ -65,7 +65,7 @@ struct AccelOptions {
   bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
   Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
   int wide_width = 4;                     // treelets (Line Space structures): 4 or 8, chosen by measurement
-  int exact_width = default_exact_width();  // the order-free walk's nodes: 4 or 8 (docs/performance.md)
+  int exact_width = 8;                    // the order-free walk's nodes: 4 or 8, chosen by measurement
   AccelOptions() = default;
   AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
 };

@@ -56,7 +56,7 @@ struct LsFlags {
     app->add_option("--wide-width", wide_width, "treelet width of the fast path's ordered walk (Line Space structures): 4 or 8")
         ->capture_default_str()->check(CLI::IsMember({4, 8}));
     app->add_option("--exact-width", exact_width,
-                    "node width of the fast path's order-free walk (exact structures, below LS nodes): 4 or 8; default: this build's")
+                    "node width of the fast path's order-free walk (exact structures, below LS nodes): 4 or 8")
         ->capture_default_str()->check(CLI::IsMember({4, 8}));
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));

@@ -1,6 +1,6 @@
 // The wide BVH of the fast path's order-free walk: 4- or 8-wide nodes that hold only their children's
 // boxes (SoA, 128 or 256 bytes a node, like Embree's), traversed nearest child first.  The width is
-// the build's choice (default_exact_width(), fast_tracer.h) or --exact-width.
+// AccelOptions::exact_width (--exact-width; 8 by default, docs/performance.md).
 //
 // Why it may ignore the reference's visiting order: a closest-hit query's answer does not depend on
 // it (the smaller t wins, ties go to the lower (instance, triangle): common/kernels/hit.h), and the

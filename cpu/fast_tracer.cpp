@@ -34,11 +34,6 @@ std::string fast_path_isa() {
   return std::string(SimdArch::name()) + " (" + std::to_string(FloatBatch::size) + " floats)";
 }
 
-// 8-wide where the box tests run 8 floats at once (AVX builds): faster than 4-wide on nearly every
-// scene there.  With SSE2 an 8-wide node takes two batches and runs more instructions a ray than
-// 4-wide on the larger scenes, so 4 there (docs/performance.md, "The order-free tree's width").
-int default_exact_width() { return FloatBatch::size >= 8 ? 8 : 4; }
-
 namespace {
 
 using lsk::Hit;

@@ -59,9 +59,6 @@ class FastTracer {
 // Other widths are an InputError.  The Accel's arrays must stay where they are.
 std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width, int exact_width);
 
-// The exact wide tree's width this build picks: 8 where its box tests run 8 floats (AVX), else 4.
-int default_exact_width();
-
 // The SIMD instruction set the fast path was compiled for, e.g. "sse2 (4 floats)".
 std::string fast_path_isa();
 

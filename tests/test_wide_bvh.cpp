@@ -252,8 +252,7 @@ TEST_CASE("wide BVH: trace_rays takes the fast path by default and the reference
   CHECK(fast.fast != nullptr);
   CHECK(fast.bytes_wide() > 0);
   CHECK(fast.fast->width() == 4);
-  CHECK(fast.fast->exact_width() == ls::default_exact_width());
-  CHECK((ls::default_exact_width() == 4 || ls::default_exact_width() == 8));
+  CHECK(fast.fast->exact_width() == 8);  // the default, chosen by measurement (docs/performance.md)
   ls::AccelOptions o;
   o.traversal = ls::parse_traversal("reference");
   const ls::Accel ref = ls::build_accel(scene, ls::parse_structure("f-ls:4:3"), o);
