@@ -12,9 +12,9 @@
 
 namespace ls {
 
-// The batch the box tests run in: 8 floats with AVX (LINESPACE_ISA=native on these machines), else
-// 4 (SSE2, the portable x86-64 default; NEON on aarch64).  AVX-512's 16 floats would be wider than a
-// 4-wide treelet's 6 boxes, so 8 is the most taken.
+// The batch the box tests run in: 8 floats with AVX (LINESPACE_ISA=avx2 or native), else 4 (SSE2,
+// the portable x86-64 default; NEON on aarch64).  AVX-512's 16 floats would be wider than an 8-wide
+// node or a 4-wide treelet's 6 boxes, so 8 is the most taken.
 #if XSIMD_WITH_AVX
 using SimdArch = xsimd::avx;
 #else
