@@ -344,7 +344,7 @@ struct ExactWalk {
     if (tn[other] < tn[near]) std::swap(near, other);
     if (lanes == 0u) {  // two: push the farther, go on with the nearer
       push(other);
-    } else {  // three or four: push them farthest first, go on with the nearest
+    } else {  // three or more: push them farthest first, go on with the nearest
       unsigned order[W] = {near, other};
       unsigned n = 2;
       for (; lanes != 0u; lanes &= lanes - 1u) {
@@ -493,14 +493,6 @@ class WideTracer final : public FastTracer {
     }
   }
 
-  // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
-  // the order-free walk below the entries it reaches, except for the reference's any hit.  Returns
-  // true when an any-hit or occlusion query found its hit (the caller stops).  Always inlined: GCC
-  // otherwise chose by a hair whether an instance's walk sat in the top walk or behind a call
-  // (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change elsewhere).  kSearch:
-  // the LS build's search gets its own copy of the walks it inlines; sharing them added a caller
-  // to the instance's exact walk, which GCC then left out of line (2l-bvh on generated 3,388 ->
-  // 3,483).
   // The ray's BlockRay, made when first asked: many rays that enter an instance's box never reach
   // a triangle of it.
   struct LazyBlockRay {
@@ -519,7 +511,8 @@ class WideTracer final : public FastTracer {
     }
   };
 
-  // The order-free walk below `entry`, leaves tested against tri_ray().  True: an occlusion query's hit.
+  // The order-free walk below `entry`, leaves tested against tri_ray().  True: an occlusion query's
+  // hit (any_hit is one here: the reference's any hit never walks order-free).
   LS_ALWAYS_INLINE bool run_exact(lsk::TraceContext& c, uint entry, const ExactBoxRay<W>& exact_ray, LazyBlockRay& tri_ray,
                                   float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
     bool stopped = false;
@@ -542,8 +535,8 @@ class WideTracer final : public FastTracer {
 
   // A query that is one order-free walk from the entry at the root (the entry's node tests the
   // root's children, which pass only where the root would): an exact structure's, or an instance's
-  // object without a Line Space at its root.  Kept apart from the treelet walk's closures, which
-  // cost about 50 stores a ray before any box is tested.
+  // object without a Line Space at its root.  Kept apart from the treelet walk's closures, whose
+  // stores cost about 20 instructions a ray before any box is tested.
   LS_ALWAYS_INLINE bool trace_entry(lsk::TraceContext& c, uint entry, const vec3& origin, const vec3& dir, const vec3& inv_dir,
                                     float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
     ExactBoxRay<W> exact_ray;
@@ -552,6 +545,14 @@ class WideTracer final : public FastTracer {
     return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
   }
 
+  // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
+  // the order-free walk below the entries it reaches, except for the reference's any hit.  Returns
+  // true when an any-hit or occlusion query found its hit (the caller stops).  Always inlined: GCC
+  // otherwise chose by a hair whether an instance's walk sat in the top walk or behind a call
+  // (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change elsewhere).  kSearch:
+  // the LS build's search gets its own copy of the walks it inlines; sharing them added a caller
+  // to the instance's exact walk, which GCC then left out of line (2l-bvh on generated 3,388 ->
+  // 3,483).
   template <bool kSearch = false>
   LS_ALWAYS_INLINE bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin,
                                   uint instance, Query q, bool use_ls, Hit& hit, uint& hit_prim) const {
@@ -574,6 +575,8 @@ class WideTracer final : public FastTracer {
       }
       return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
     };
+    // A call from the treelet walk: inlined there it outgrew GCC's budget (f-ls:8:6 on cornell
+    // 2,818 -> 3,045 instructions a ray).
     auto exact_call = [&](uint entry) __attribute__((noinline)) { return exact(entry); };
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
@@ -628,8 +631,9 @@ class WideTracer final : public FastTracer {
       instances(root.first, root.count);
     else if (q != Query::AnyHit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no decision depends on the order
       [&]() __attribute__((noinline)) {  // its own function, with the instances' walks inlined in it (fewer spills)
-        walk_exact(top_exact_, top_exact_.entry_of[0], make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir, true), ray.tmin,
-                   hit, instances, [](uint) {});
+        walk_exact(top_exact_, top_exact_.entry_of[0],
+                   make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir, true), ray.tmin, hit, instances,
+                   [](uint) {});
       }();
     else
       walk(top_, top_.wide_of[0],
