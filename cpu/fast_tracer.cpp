@@ -64,7 +64,7 @@ struct SlabRay {
 };
 
 template <class Batch, class Node>
-void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const vec3& inv_dir, bool finite) {
+LS_ALWAYS_INLINE void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const vec3& inv_dir, bool finite) {
   constexpr float big = 3.0e38f;
   constexpr uint32_t row = uint32_t(sizeof(Node::lo[0]));
   const float o[3] = {origin.x, origin.y, origin.z};  // indexed in memory, not through glm's switch
@@ -503,8 +503,7 @@ class WideTracer final : public FastTracer {
     LazyBlockRay(const vec3& o, const vec3& d) : origin(o), dir(d) {}
     LS_ALWAYS_INLINE const BlockRay& operator()() {
       if (!ready) {
-        made.tri = lsk::make_tri_ray(origin, dir);
-        broadcast_block_ray(made);
+        make_block_ray(origin, dir, made);
         ready = true;
       }
       return made;

@@ -2,12 +2,13 @@
 // the watertight test (common/kernels/ray_triangle.h) run on a block four lanes at a time.
 //
 // The SIMD part is the kernel's first half (ray_triangle_edges) — translate, power-of-two rescale
-// with its flush-to-zero rule, shear, edge functions — with the same operations lane by lane, hence
-// the same values.  A lane whose edge signs reject the triangle is dropped; a lane with a zero edge
-// function (the kernel recomputes those in double) goes through the whole scalar kernel; every other
-// lane is finished by the kernel's own second half (ray_triangle_plane) on the lane's values and the
-// triangle's plane normal, which the block keeps (triangle_plane_normal, computed once).  So a hit's
-// t, u and v are the kernel's bit for bit, and lanes are offered in the leaf's order.
+// with its flush-to-zero rule, shear, edge functions — and the distance of its second half
+// (ray_triangle_plane: det, t from the triangle's plane normal, which the block keeps, and the
+// interval test), with the same operations lane by lane, hence the same values.  A lane whose edge
+// signs reject the triangle is dropped; a lane with a zero edge function (the kernel recomputes those
+// in double) goes through the whole scalar kernel; a lane whose t lies in the interval gets the
+// kernel's weights.  So a hit's t, u and v are the kernel's bit for bit, and lanes are offered in the
+// leaf's order.
 #pragma once
 
 #include "simd.h"
@@ -69,6 +70,7 @@ struct BlockEdges {
   alignas(16) float eu[4];
   alignas(16) float ev[4];
   alignas(16) float ew[4];
+  alignas(16) float t[4];  // block_distances: the kernel's t before positive_zero
   unsigned full = 0;
   unsigned finish = 0;
 };
@@ -80,19 +82,52 @@ struct BlockRay {
   Float4 origin[3];  // origin component of sheared axis a, in every lane
   Float4 shear_x;
   Float4 shear_y;
+  Float4 dir[3];     // the scaled direction (tri.dir), x, y, z, in every lane
   uint32_t axis[3];  // kx, ky, kz
+  uint32_t row_of[3];  // the sheared axis of x, y and z (axis[row_of[i]] == i)
 };
 
-// Sets b from b.tri.
-LS_ALWAYS_INLINE void broadcast_block_ray(BlockRay& b) {
-  const lsk::TriRay& r = b.tri;
-  b.axis[0] = r.kx;
-  b.axis[1] = r.ky;
-  b.axis[2] = r.kz;
-  const float origin[3] = {r.origin.x, r.origin.y, r.origin.z};  // indexed in memory, not through glm's switch
-  for (int a = 0; a < 3; ++a) b.origin[a] = Float4(origin[b.axis[a]]);
-  b.shear_x = Float4(r.sx);
-  b.shear_y = Float4(r.sy);
+// b for a ray: b.tri is lsk::make_tri_ray(origin, dir), bit for bit (the same operations: the
+// direction rescaled four lanes at once by block_lanes::scale_pow2, the three quotients of the shear
+// in one division), and the lanes broadcast from it.  The kernel's own version picks components by
+// selects, and its result was copied about: this saves 10-11 instructions a ray (callgrind, bvh).
+LS_ALWAYS_INLINE void make_block_ray(const lsk::vec3& origin, const lsk::vec3& dir, BlockRay& b) {
+  lsk::TriRay& r = b.tri;
+  const int e = lsk::unit_exponent(lsk::max_abs(dir));
+  alignas(16) float d[4] = {dir.x, dir.y, dir.z, 0.0f};
+  block_lanes::scale_pow2(Float4::load_aligned(d), Int4(1 - e), Float4(lsk::pow2(e))).store_aligned(d);
+  const float ax = std::abs(d[0]);
+  const float ay = std::abs(d[1]);
+  const float az = std::abs(d[2]);
+  const uint32_t kz = ax >= ay ? (ax >= az ? 0u : 2u) : (ay >= az ? 1u : 2u);
+  uint32_t kx = kz == 2u ? 0u : kz + 1u;
+  uint32_t ky = kx == 2u ? 0u : kx + 1u;
+  if (d[kz] < 0.0f) std::swap(kx, ky);  // keep the winding, as the kernel does
+  alignas(16) float shear[4] = {d[kx], d[ky], 1.0f, 1.0f};
+  (Float4::load_aligned(shear) / Float4(d[kz])).store_aligned(shear);  // sx, sy, sz
+  r.origin = origin;
+  r.dir_exp = e;
+  r.dir = lsk::vec3(d[0], d[1], d[2]);
+  r.kx = kx;
+  r.ky = ky;
+  r.kz = kz;
+  r.sx = shear[0];
+  r.sy = shear[1];
+  r.sz = shear[2];
+  r.pad0 = 0.0f;
+  r.pad1 = 0.0f;
+  r.pad2 = 0.0f;
+  b.axis[0] = kx;
+  b.axis[1] = ky;
+  b.axis[2] = kz;
+  const float o[3] = {origin.x, origin.y, origin.z};  // indexed in memory, not through glm's switch
+  for (uint32_t a = 0; a < 3; ++a) {
+    b.origin[a] = Float4(o[b.axis[a]]);
+    b.dir[a] = Float4(d[a]);
+    b.row_of[b.axis[a]] = a;
+  }
+  b.shear_x = Float4(shear[0]);
+  b.shear_y = Float4(shear[1]);
 }
 
 // The vertices are read in the ray's axis order (kx, ky, kz) straight from the block, so no axis is
@@ -165,6 +200,48 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, Bloc
   }
 }
 
+// The rest of ray_triangle_plane on the `lanes` of a block that block_edges left to finish, four
+// at a time with the kernel's operations lane by lane: det = eu + ev + ew, t = dot(n, a) / dot(n, dir)
+// summed in x, y, z order, rescaled by 2^(dir_exp - ks).  Returns the lanes the kernel does not
+// reject before its weights (det and dot(n, dir) not zero, t in [tmin, tmax]); their t (before
+// positive_zero) is in e.t.  The rescale sets the exponent field where the result stays normal; a
+// lane where it would not (a denormal quotient, an exponent off the range) takes the kernel's own
+// scale_pow2.
+LS_ALWAYS_INLINE unsigned block_distances(const TriBlock& block, const BlockRay& r, BlockEdges& e, float tmin, float tmax,
+                                          unsigned lanes) {
+  const Float4 det = (Float4::load_aligned(e.eu) + Float4::load_aligned(e.ev)) + Float4::load_aligned(e.ew);
+  const Float4 nx = Float4::load_aligned(block.n[0]);
+  const Float4 ny = Float4::load_aligned(block.n[1]);
+  const Float4 nz = Float4::load_aligned(block.n[2]);
+  const Float4 tn = (nx * Float4::load_aligned(e.a[r.row_of[0]]) + ny * Float4::load_aligned(e.a[r.row_of[1]])) +
+                    nz * Float4::load_aligned(e.a[r.row_of[2]]);
+  const Float4 td = (nx * r.dir[0] + ny * r.dir[1]) + nz * r.dir[2];
+  const Float4 quotient = tn / td;
+  const Int4 shift = Int4(r.tri.dir_exp) - Int4::load_aligned(e.ks);
+  const Int4 bits = xsimd::bitwise_cast<Int4>(quotient);
+  const Int4 field = (bits >> 23) & Int4(255);
+  const Int4 moved = field + shift;
+  Float4 t = xsimd::bitwise_cast<Float4>((bits & Int4(int32_t(0x807FFFFFu))) | (moved << 23));
+  // Both fields in [1, 254]: field - 1 and moved - 1 in [0, 253], so none of the four below is negative.
+  const Int4 f1 = field - Int4(1);
+  const Int4 m1 = moved - Int4(1);
+  const unsigned slow = lanes & lane_bits((f1 | m1 | (Int4(253) - f1) | (Int4(253) - m1)) < Int4(0));
+  t.store_aligned(e.t);
+  if (slow != 0u) {
+    alignas(16) float q[4];
+    alignas(16) int32_t k[4];
+    quotient.store_aligned(q);
+    shift.store_aligned(k);
+    for (unsigned rest = slow; rest != 0u; rest &= rest - 1u) {
+      const unsigned l = unsigned(std::countr_zero(rest));
+      e.t[l] = lsk::scale_pow2(q[l], k[l]);
+    }
+    t = Float4::load_aligned(e.t);
+  }
+  const Float4 zero(0.0f);
+  return lanes & lane_bits((det != zero) && (td != zero) && (t >= Float4(tmin)) && (t <= Float4(tmax)));
+}
+
 // lsk::TraceContext::trace_leaf over blocks: the `count` triangles from lane index `lane` on, tested
 // and offered in that order.  Returns true when any_hit is set and a hit was found (the caller
 // stops).  Flattened: the kernel's halves are inlined into it.
@@ -176,8 +253,10 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, Bloc
   for (uint32_t at = lane, end = lane + count; at < end; at = (at | 3u) + 1u) {
     const TriBlock& blk = blocks[at / 4u];
     block_edges(blk, block_ray, e);
-    unsigned lanes = (e.full | e.finish) & (15u << (at % 4u));
-    if (end - (at & ~3u) < 4u) lanes &= (1u << (end - (at & ~3u))) - 1u;
+    unsigned in_leaf = 15u << (at % 4u);
+    if (end - (at & ~3u) < 4u) in_leaf &= (1u << (end - (at & ~3u))) - 1u;
+    const unsigned finish = e.finish & in_leaf;
+    unsigned lanes = (e.full & in_leaf) | (finish != 0u ? block_distances(blk, block_ray, e, tmin, hit.t, finish) : 0u);
     while (lanes != 0u) {
       const unsigned l = unsigned(std::countr_zero(lanes));
       lanes &= lanes - 1u;
@@ -190,20 +269,14 @@ LS_ALWAYS_INLINE void block_edges(const TriBlock& block, const BlockRay& r, Bloc
         const lsk::vec3 p1(blk.v[1][0][l], blk.v[1][1][l], blk.v[1][2][l]);
         const lsk::vec3 p2(blk.v[2][0][l], blk.v[2][1][l], blk.v[2][2][l]);
         hits = lsk::ray_triangle(tri_ray, tmin, hit.t, p0, p1, p2, t, u, v);
-      } else {
-        float a[3];  // back from the sheared axes (kx, ky, kz) to x, y, z
-        a[tri_ray.kx] = e.a[0][l];
-        a[tri_ray.ky] = e.a[1][l];
-        a[tri_ray.kz] = e.a[2][l];
-        lsk::TriEdges edges;
-        edges.a = lsk::vec3(a[0], a[1], a[2]);
-        edges.ks = e.ks[l];
-        edges.eu = e.eu[l];
-        edges.ev = e.ev[l];
-        edges.ew = e.ew[l];
-        edges.pad = 0.0f;
-        const lsk::vec3 n(blk.n[0][l], blk.n[1][l], blk.n[2][l]);
-        hits = lsk::ray_triangle_plane(tri_ray, tmin, hit.t, n, edges, t, u, v);
+      } else {  // block_distances kept it for the hit at the block's start; the hit may be closer now
+        hits = e.t[l] <= hit.t;
+        if (hits) {  // the kernel's weights
+          const float det = (e.eu[l] + e.ev[l]) + e.ew[l];
+          t = lsk::positive_zero(e.t[l]);
+          u = e.ev[l] / det;
+          v = e.ew[l] / det;
+        }
       }
       if (!hits) continue;
       const uint32_t i = blk.prim[l];

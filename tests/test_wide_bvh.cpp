@@ -354,6 +354,51 @@ float float_with_field(Rng& rng, uint32_t field) {
   return std::bit_cast<float>((rng.gen() % 2 ? 0x80000000u : 0u) | field << 23 | mantissa);
 }
 
+TEST_CASE("make_block_ray's triangle ray is the kernel's make_tri_ray, bit for bit", "[wide]") {
+  // Directions whose components have every exponent field (zero, denormal, normal, huge, inf, NaN),
+  // either sign, ties between their magnitudes (the axis choice) and -0.
+  Rng rng(23);
+  size_t checked = 0, mismatches = 0;
+  auto component = [&](int kind) {
+    switch (kind) {
+      case 0: return 0.0f;
+      case 1: return -0.0f;
+      case 2: return kInf;
+      case 3: return -kInf;
+      case 4: return std::numeric_limits<float>::quiet_NaN();
+      default: return float_with_field(rng, uint32_t(rng.gen() % 256));
+    }
+  };
+  for (int trial = 0; trial < 200000; ++trial) {
+    glm::vec3 dir;
+    for (int a = 0; a < 3; ++a) dir[a] = component(trial % 4 == 0 ? int(rng.gen() % 8) : 5);
+    if (trial % 5 == 1) dir[rng.gen() % 3] = dir[rng.gen() % 3];  // equal magnitudes: the tie rule of kz
+    if (trial % 5 == 2) dir[rng.gen() % 3] = -dir[rng.gen() % 3];
+    const glm::vec3 origin = rng.vec(-1e3f, 1e3f);
+    const lsk::TriRay want = lsk::make_tri_ray(origin, dir);
+    ls::BlockRay got;
+    ls::make_block_ray(origin, dir, got);
+    ++checked;
+    // Bit for bit, a NaN (0 / 0 shear, a NaN direction) only as a NaN.
+    auto same = [](float x, float y) { return (std::isnan(x) && std::isnan(y)) || std::bit_cast<uint32_t>(x) == std::bit_cast<uint32_t>(y); };
+    bool ok = got.tri.dir_exp == want.dir_exp && got.tri.kx == want.kx && got.tri.ky == want.ky && got.tri.kz == want.kz &&
+              same(got.tri.sx, want.sx) && same(got.tri.sy, want.sy) && same(got.tri.sz, want.sz);
+    for (int a = 0; a < 3; ++a) ok = ok && same(got.tri.dir[a], want.dir[a]) && same(got.tri.origin[a], want.origin[a]);
+    // The lanes broadcast from it: the origin in the sheared axes' order, the shear.
+    const uint32_t axes[3] = {want.kx, want.ky, want.kz};
+    for (int a = 0; a < 3; ++a) {
+      ok = ok && got.axis[a] == axes[a];
+      for (size_t l = 0; l < ls::Float4::size; ++l) ok = ok && same(got.origin[a].get(l), want.origin[axes[a]]);
+    }
+    for (size_t l = 0; l < ls::Float4::size; ++l) ok = ok && same(got.shear_x.get(l), want.sx) && same(got.shear_y.get(l), want.sy);
+    if (!ok && mismatches++ < 5)
+      UNSCOPED_INFO("dir bits " << std::hex << std::bit_cast<uint32_t>(dir.x) << ' ' << std::bit_cast<uint32_t>(dir.y) << ' '
+                                << std::bit_cast<uint32_t>(dir.z));
+  }
+  CHECK(checked == 200000);
+  CHECK(mismatches == 0);
+}
+
 TEST_CASE("triangle blocks: every lane gives the scalar kernel's hit, from denormal to huge coordinates", "[wide]") {
   // The block test's rescale (max, exponent clamp to [-126, 126], flush rule) against
   // lsk::ray_triangle, one lane at a time: triangles whose offsets from the origin have exponents
@@ -373,8 +418,7 @@ TEST_CASE("triangle blocks: every lane gives the scalar kernel's hit, from denor
     dir *= lsk::pow2(int(rng.gen() % 61) - 30);
     if (dir == glm::vec3(0.0f)) continue;
     ls::BlockRay block_ray;
-    block_ray.tri = lsk::make_tri_ray(origin, dir);
-    ls::broadcast_block_ray(block_ray);
+    ls::make_block_ray(origin, dir, block_ray);
     // Each triangle at one scale: 2^e with e spread over the whole range, a third of them near the
     // ray (on its line, plus small offsets) so that lanes pass the edge test.
     ls::TriBlock block{};
