@@ -195,6 +195,7 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
   // The fast path's wide trees need the Line Space's nodes, not its candidates: made before the
   // search, which then runs on it.
   const auto wide_start = std::chrono::steady_clock::now();
+  check_fast_path_budget(accel, options.wide_width, options.exact_width, options.ls.max_memory);
   accel.fast = make_fast_tracer(accel, options.wide_width, options.exact_width);
   accel.traversal = options.traversal;
   accel.wide_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wide_start).count();

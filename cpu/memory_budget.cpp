@@ -1,7 +1,11 @@
 #include "memory_budget.h"
 
+#include "accel.h"
+#include "exact_wide_bvh.h"
 #include "kernels/layouts.h"
 #include "kernels/line_space.h"
+#include "triangle_blocks.h"
+#include "wide_bvh.h"
 
 #include <algorithm>
 #include <cmath>
@@ -88,6 +92,59 @@ void check_structure_budget(const Scene& scene, const StructureSpec& spec, const
          : spec.line_space() ? "lower N or D, raise --ls-min-triangles, or raise --max-memory"
                              : "use a smaller scene or raise --max-memory";
   throw InputError(why);
+}
+
+namespace {
+
+// What fast_path_bytes_at_most needs of one binary BVH array.
+struct BvhShape {
+  size_t nodes = 0;
+  size_t inner = 0;
+  size_t leaves = 0;
+  size_t blocks = 0;  // ceil(count / 4) summed over the leaves
+};
+
+BvhShape bvh_shape(const std::vector<lsk::BvhNode>& nodes) {
+  BvhShape s;
+  s.nodes = nodes.size();
+  for (const lsk::BvhNode& n : nodes)
+    if (n.count > 0) {
+      ++s.leaves;
+      s.blocks += (size_t(n.count) + 3u) / 4u;
+    } else {
+      ++s.inner;
+    }
+  return s;
+}
+
+}  // namespace
+
+size_t fast_path_bytes_at_most(const Accel& accel, int width, int exact_width) {
+  const size_t w = size_t(exact_width);
+  const size_t exact_node = exact_width == 8 ? sizeof(ExactWideNode<8>) : sizeof(ExactWideNode<4>);
+  const size_t treelet_node = width == 8 ? sizeof(WideNode<3>) : sizeof(WideNode<2>);
+  const bool treelets = accel.spec.line_space();
+  auto exact_nodes = [&](size_t leaves) { return (leaves * w + 2 * (w - 1) - 1) / (2 * (w - 1)); };  // rounded up
+  const BvhShape object = bvh_shape(accel.nodes);
+  size_t bytes = exact_nodes(object.leaves) * exact_node + object.blocks * sizeof(TriBlock) +
+                 2 * object.nodes * sizeof(uint32_t);  // entry_of, lane_of
+  if (treelets) bytes += object.inner * treelet_node + object.nodes * sizeof(uint32_t);  // wide_of
+  if (accel.spec.two_level()) {
+    const BvhShape top = bvh_shape(accel.top_nodes);
+    bytes += exact_nodes(top.leaves) * exact_node + top.nodes * sizeof(uint32_t);
+    if (treelets) bytes += top.inner * treelet_node + top.nodes * sizeof(uint32_t);
+  }
+  return bytes;
+}
+
+void check_fast_path_budget(const Accel& accel, int width, int exact_width, size_t max_memory) {
+  const size_t budget = memory_budget(max_memory);
+  const size_t built = accel.bytes_total();
+  const size_t fast = fast_path_bytes_at_most(accel, width, exact_width);
+  if (built <= budget && fast <= budget - built) return;
+  throw InputError("the fast path of structure '" + accel.spec.name() + "' (its wide trees and triangle blocks) would take up to " +
+                   mib(double(fast)) + " beside the structure's " + mib(double(built)) + ", over the budget of " +
+                   mib(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
 }
 
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces) {

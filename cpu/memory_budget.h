@@ -31,6 +31,20 @@ StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSp
 // Throws InputError when estimate_structure_bytes() exceeds memory_budget(ls.max_memory).
 void check_structure_budget(const Scene& scene, const StructureSpec& spec, const LsOptions& ls);
 
+// Upper bound of the bytes of the fast path's trees and triangle blocks (FastTracer::bytes()) for a
+// built structure, from the shape of its binary BVHs: the order-free tree's nodes (each has the
+// width's children, or fewer and all of them leaves, at least two; so with L leaves at most
+// L W / (2 (W - 1)) nodes, and its leaves are at most the binary leaves), one treelet per binary inner
+// node at most (Line Space structures), ceil(count / 4) blocks per binary leaf at most, and one index
+// entry per binary node for each of them.  Built after the BVH, checked before the fast path is made:
+// estimate_structure_bytes() covers the BVH's build, not these.
+struct Accel;
+size_t fast_path_bytes_at_most(const Accel& accel, int width, int exact_width);
+
+// Throws InputError when accel.bytes_total() plus fast_path_bytes_at_most() exceeds
+// memory_budget(max_memory).
+void check_fast_path_budget(const Accel& accel, int width, int exact_width, size_t max_memory);
+
 // Bytes of the render's image and per-pixel buffers: (bounces + 2) images of 12 B per pixel, the
 // wavefront state (~170 B per pixel) and the 8-bit PNG, for width x height pixels.
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces);

@@ -37,6 +37,49 @@ TEST_CASE("structure estimates bound the bytes the built structures hold", "[bud
   }
 }
 
+TEST_CASE("the fast path's bound covers its wide trees and blocks, and a structure without room for it is refused", "[budget]") {
+  // Every width pairing, flat and two-level, exact and Line Space, on a scene of unique meshes and
+  // on an instanced one.
+  for (const char* scene_name : {"cornell", "generated:20000:7:3", "instances"}) {
+    const Scene scene = builtin_scene(scene_name);
+    for (const char* name : {"bvh", "2l-bvh", "f-ls:3:4", "2l-ls:2:3"}) {
+      if (std::string(scene_name) == "instances" && !parse_structure(name).two_level()) continue;  // 3.3 million world triangles
+      for (int width : {4, 8})
+        for (int exact_width : {4, 8}) {
+          AccelOptions options;
+          options.wide_width = width;
+          options.exact_width = exact_width;
+          options.search_candidates = false;
+          const Accel accel = build_accel(scene, parse_structure(name), options);
+          const size_t bound = fast_path_bytes_at_most(accel, width, exact_width);
+          INFO(scene_name << " " << name << " widths " << width << "/" << exact_width << ": bound " << bound << ", built "
+                          << accel.bytes_wide());
+          CHECK(accel.bytes_wide() > 0);
+          CHECK(bound >= accel.bytes_wide());
+          CHECK(bound <= 4 * accel.bytes_wide());  // a bound, not a refusal of everything
+        }
+    }
+  }
+  // f-ls:3:4 on cornell: its parameter estimate (the BVH's build, the Line Space) fits a budget of
+  // exactly that estimate, the structure and its fast path together do not.
+  const Scene scene = builtin_scene("cornell");
+  const StructureSpec spec = parse_structure("f-ls:3:4");
+  AccelOptions options;
+  options.ls.paper_candidates = true;
+  options.ls.min_triangles = 1;
+  options.search_candidates = false;
+  const Accel fits = build_accel(scene, spec, options);
+  const size_t whole = fits.bytes_total() + fits.bytes_wide();
+  options.ls.max_memory = estimate_structure_bytes(scene, spec, options.ls).total();
+  INFO("estimate " << options.ls.max_memory << ", structure and fast path " << whole);
+  REQUIRE(options.ls.max_memory < whole);
+  CHECK_THROWS_WITH(build_accel(scene, spec, options),
+                    Contains("fast path") && Contains("triangle blocks") && Contains("over the budget") &&
+                        Contains("--max-memory"));
+  options.ls.max_memory = whole + fast_path_bytes_at_most(fits, options.wide_width, options.exact_width);
+  CHECK_NOTHROW(build_accel(scene, spec, options));
+}
+
 TEST_CASE("N = 64 and D = 30 on builtin:instances are refused in well under 2 s", "[budget]") {
   const Scene scene = builtin_scene("instances");
   AccelOptions options;
