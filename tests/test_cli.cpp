@@ -207,11 +207,13 @@ TEST_CASE("render writes every image and a report", "[cli]") {
 // The bound includes process start and loading builtin:instances (~0.3 s of CPU; seconds of wall time on a
 // loaded machine or under ASan): an attempted build would take hours or be killed for memory.
 TEST_CASE("over-budget structures and renders exit 2 within seconds naming estimate, budget and flag", "[cli]") {
-  // 4000 MB = 3815 MiB (rounded up), 16 MB = 16 MiB.
-  const std::array<std::tuple<std::string, std::string, std::string>, 4> cases = {{
+  // 4000 MB = 3815 MiB (rounded up), 16 MB = 16 MiB, 5 MB = 5 MiB.  The fourth: the BVH's estimate
+  // fits 5 MB, the structure and its fast path's bound do not (memory_budget.h).
+  const std::array<std::tuple<std::string, std::string, std::string>, 5> cases = {{
       {"build --scene builtin:instances --structure f-ls:8:64 --max-memory 4000", "budget of 3815 MiB", "lower N or D"},
       {"build --scene builtin:instances --structure f-ls:30:10 --max-memory 4000", "budget of 3815 MiB", "lower N or D"},
       {"build --scene builtin:instances --structure bvh --max-memory 16", "budget of 16 MiB", "smaller scene"},
+      {"build --scene builtin:generated:20000:7:3 --structure bvh --max-memory 5", "budget of 5 MiB", "the fast path of"},
       {"render --scene builtin:cornell --size 16384x16384 --bounces 64 --max-memory 4000 --out " + temp("big").string(),
        "budget of 3815 MiB", "--size"},
   }};
