@@ -2,6 +2,7 @@
 
 #include "accel.h"
 #include "embree_tracer.h"
+#include "memory_budget.h"
 
 #include <tbb/info.h>
 
@@ -35,8 +36,26 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   result.exact_width = options.exact_width;
   result.any_hit = any_hit;
 
+  // The structures stay built together for the timed runs: each is refused over what the ones
+  // before it left of the budget (memory_budget.h), so that together they stay within it.
+  const size_t budget = memory_budget(options.ls.max_memory);
+  size_t held = 0;  // bytes of the structures built so far, their fast paths included
+  auto mib = [](size_t bytes) { return std::to_string((bytes + (size_t(1) << 20) - 1) >> 20) + " MiB"; };
   std::vector<Accel> built;
-  for (const StructureSpec& spec : structures) built.push_back(build_accel(scene, spec, options));
+  for (const StructureSpec& spec : structures) {
+    const std::string held_by = "bench holds its structures at once, and the ones before '" + spec.name() + "' take " +
+                                mib(held) + " of the budget of " + mib(budget) + ": bench fewer --structures or raise --max-memory";
+    if (held >= budget) throw InputError(held_by);
+    AccelOptions left = options;
+    left.ls.max_memory = budget - held;
+    try {
+      built.push_back(build_accel(scene, spec, left));
+    } catch (const InputError& e) {
+      if (held == 0) throw;
+      throw InputError(std::string(e.what()) + " (" + held_by + ")");
+    }
+    held += built.back().bytes_total() + built.back().bytes_wide();
+  }
   EmbreeTracer embree(scene, embree_isa);
   result.embree_isa = embree.isa();
 

@@ -174,6 +174,24 @@ TEST_CASE("bench prints DESIGN 9's JSON keys for each structure and Embree, clos
   }
 }
 
+TEST_CASE("bench refuses structures that fit --max-memory one by one but not together", "[cli]") {
+  // Each of bvh and 2l-bvh, with its fast path, fits 6 MB on this scene; bench holds both at once.
+  const std::string args = "bench --scene builtin:generated:20000:7:3 --count 1000 --repeat 1 --max-memory 6 --structures ";
+  for (const char* one : {"bvh", "2l-bvh"}) {
+    const Run r = run(args + one);
+    INFO(one << "\nstderr: " << r.err);
+    CHECK(r.status == 0);
+  }
+  const Run both = run(args + "bvh,2l-bvh");
+  INFO(both.err);
+  CHECK(both.status == 2);
+  CHECK(line_count(both.err) == 1);
+  CHECK(both.err.find("structure '2l-bvh'") != std::string::npos);
+  CHECK(both.err.find("bench holds its structures at once") != std::string::npos);
+  CHECK(both.err.find("bench fewer --structures") != std::string::npos);
+  CHECK(both.err.find("--max-memory") != std::string::npos);
+}
+
 TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a name Embree does not know", "[cli]") {
   const Run r = run("bench --scene builtin:cornell --count 2000 --repeat 1 --structures bvh --embree-isa sse2");
   INFO(r.err);
