@@ -40,11 +40,10 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   // before it left of the budget (memory_budget.h), so that together they stay within it.
   const size_t budget = memory_budget(options.ls.max_memory);
   size_t held = 0;  // bytes of the structures built so far, their fast paths included
-  auto mib = [](size_t bytes) { return std::to_string((bytes + (size_t(1) << 20) - 1) >> 20) + " MiB"; };
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) {
     const std::string held_by = "bench holds its structures at once, and the ones before '" + spec.name() + "' take " +
-                                mib(held) + " of the budget of " + mib(budget) + ": bench fewer --structures or raise --max-memory";
+                                mib_text(double(held)) + " of the budget of " + mib_text(double(budget)) + ": bench fewer --structures or raise --max-memory";
     if (held >= budget) throw InputError(held_by);
     AccelOptions left = options;
     left.ls.max_memory = budget - held;

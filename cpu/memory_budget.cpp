@@ -12,9 +12,9 @@
 #include <vector>
 
 namespace ls {
-namespace {
+std::string mib_text(double bytes) { return std::to_string(uint64_t(std::ceil(bytes / double(1 << 20)))) + " MiB"; }
 
-std::string mib(double bytes) { return std::to_string(uint64_t(std::ceil(bytes / double(1 << 20)))) + " MiB"; }
+namespace {
 
 // Per triangle while building: the triangle (48 B), its id and instance (8 B), its box, the builder's
 // primitive reference and the order it returns (24 + 32 + 4 B, ~64 B), the flat build's world copy
@@ -81,13 +81,13 @@ void check_structure_budget(const Scene& scene, const StructureSpec& spec, const
   const size_t budget = memory_budget(ls.max_memory);
   const StructureEstimate e = estimate_structure_bytes(scene, spec, ls);
   if (e.total() <= budget) return;
-  std::string why = "structure '" + spec.name() + "' would take up to " + mib(double(e.total())) + " (";
+  std::string why = "structure '" + spec.name() + "' would take up to " + mib_text(double(e.total())) + " (";
   if (spec.budgeted)
-    why += "Line Space budget " + mib(double(e.ls_bytes)) + "; ";
+    why += "Line Space budget " + mib_text(double(e.ls_bytes)) + "; ";
   else if (spec.line_space())
-    why += "Line Space " + mib(double(e.ls_bytes)) + ": up to " + std::to_string(e.ls_nodes_at_most) + " LS nodes" +
+    why += "Line Space " + mib_text(double(e.ls_bytes)) + ": up to " + std::to_string(e.ls_nodes_at_most) + " LS nodes" +
            (ls.objects.empty() ? " x " + std::to_string(lsk::ls_shaft_count(uint32_t(spec.subdivision))) + " shafts; " : "; ");
-  why += "BVH and triangles " + mib(double(e.bvh_bytes)) + "), over the budget of " + mib(double(budget)) + ": ";
+  why += "BVH and triangles " + mib_text(double(e.bvh_bytes)) + "), over the budget of " + mib_text(double(budget)) + ": ";
   why += spec.budgeted       ? "lower --ls-budget or raise --max-memory"
          : spec.line_space() ? "lower N or D, raise --ls-min-triangles, or raise --max-memory"
                              : "use a smaller scene or raise --max-memory";
@@ -143,8 +143,8 @@ void check_fast_path_budget(const Accel& accel, int width, int exact_width, size
   const size_t fast = fast_path_bytes_at_most(accel, width, exact_width);
   if (built <= budget && fast <= budget - built) return;
   throw InputError("the fast path of structure '" + accel.spec.name() + "' (its wide trees and triangle blocks) would take up to " +
-                   mib(double(fast)) + " beside the structure's " + mib(double(built)) + ", over the budget of " +
-                   mib(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
+                   mib_text(double(fast)) + " beside the structure's " + mib_text(double(built)) + ", over the budget of " +
+                   mib_text(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
 }
 
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces) {
@@ -159,8 +159,8 @@ void check_render_budget(uint32_t width, uint32_t height, int bounces, size_t ma
   const size_t estimate = estimate_render_bytes(width, height, bounces);
   if (estimate <= budget) return;
   throw InputError("render " + std::to_string(width) + "x" + std::to_string(height) + " with " + std::to_string(bounces) +
-                   " bounces would take about " + mib(double(estimate)) + " of image buffers, over the budget of " +
-                   mib(double(budget)) + ": lower --size or --bounces, or raise --max-memory");
+                   " bounces would take about " + mib_text(double(estimate)) + " of image buffers, over the budget of " +
+                   mib_text(double(budget)) + ": lower --size or --bounces, or raise --max-memory");
 }
 
 }  // namespace ls

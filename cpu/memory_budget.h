@@ -17,6 +17,9 @@ namespace ls {
 // max_memory in bytes, or half of the physical memory when 0.
 size_t memory_budget(size_t max_memory);
 
+// Bytes as the refusals name them: whole MiB, rounded up ("13 MiB").
+std::string mib_text(double bytes);
+
 // Upper bound of the bytes of a structure: BVH nodes, triangles and ids, the build's temporary
 // arrays, and for F-LS / 2L-LS the Line Space at min(2^D, triangles / min_triangles) LS nodes per
 // BVH (subtrees at one depth are disjoint, so no more nodes can qualify), 4-byte candidates.
