@@ -16,6 +16,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace ls {
@@ -56,6 +57,47 @@ LS_ALWAYS_INLINE Float4 scale_pow2(const Float4& x, const Int4& one_minus_e, con
   const Int4 field = (bits >> 23) & Int4(255);
   const Int4 scaled = xsimd::bitwise_cast<Int4>(x * pow2_e);
   return xsimd::bitwise_cast<Float4>(xsimd::select(field < one_minus_e, bits & Int4(int32_t(0x80000000u)), scaled));
+}
+
+// lsk::triangle_plane_normal on the four lanes of a block whose vertices are set, into block.n: the
+// kernel's operations lane by lane (edges from p0, the largest |coordinate| of the two, unit_exponent
+// on its exponent field, the four-lane scale_pow2, glm's cross).  A lane with an infinite or NaN
+// edge takes the kernel itself (max and the scale would not see a NaN the same way).  Unused lanes
+// (zero vertices) get a zero normal, as the kernel gives them.
+LS_ALWAYS_INLINE void plane_normals(TriBlock& block) {
+  const Float4 magnitude = xsimd::bitwise_cast<Float4>(Int4(0x7FFFFFFF));
+  Float4 f1[3];
+  Float4 f2[3];
+  Float4 m(0.0f);
+  auto finite = xsimd::batch_bool<float, Simd4Arch>(true);
+  for (int a = 0; a < 3; ++a) {
+    const Float4 p0 = Float4::load_aligned(block.v[0][a]);
+    f1[a] = Float4::load_aligned(block.v[1][a]) - p0;
+    f2[a] = Float4::load_aligned(block.v[2][a]) - p0;
+    m = glm_max(m, glm_max(f1[a] & magnitude, f2[a] & magnitude));  // max is exact: any order
+    finite = finite && (f1[a] & magnitude) < Float4(std::numeric_limits<float>::infinity()) &&
+             (f2[a] & magnitude) < Float4(std::numeric_limits<float>::infinity());
+  }
+  // unit_exponent(m): clamp(127 - field, -126, 126) (a denormal m has field 0).  Its 0 for m == 0
+  // is not needed: every edge coordinate is then a signed zero, which any scale leaves as it is.
+  const Int4 field = xsimd::bitwise_cast<Int4>(m) >> 23;
+  Int4 e = Int4(127) - field;
+  e = xsimd::select(e > Int4(126), Int4(126), xsimd::select(e < Int4(-126), Int4(-126), e));
+  const Int4 one_minus_e = Int4(1) - e;
+  const Float4 pow2_e = xsimd::bitwise_cast<Float4>((e + Int4(127)) << 23);
+  for (int a = 0; a < 3; ++a) {
+    f1[a] = scale_pow2(f1[a], one_minus_e, pow2_e);
+    f2[a] = scale_pow2(f2[a], one_minus_e, pow2_e);
+  }
+  (f1[1] * f2[2] - f2[1] * f1[2]).store_aligned(block.n[0]);
+  (f1[2] * f2[0] - f2[2] * f1[0]).store_aligned(block.n[1]);
+  (f1[0] * f2[1] - f2[0] * f1[1]).store_aligned(block.n[2]);
+  for (unsigned rest = ~lane_bits(finite) & 15u; rest != 0u; rest &= rest - 1u) {
+    const unsigned l = unsigned(std::countr_zero(rest));
+    auto vertex = [&](int p) { return lsk::vec3(block.v[p][0][l], block.v[p][1][l], block.v[p][2][l]); };
+    const lsk::vec3 n = lsk::triangle_plane_normal(vertex(0), vertex(1), vertex(2));
+    for (int a = 0; a < 3; ++a) block.n[a][l] = n[a];
+  }
 }
 
 }  // namespace block_lanes

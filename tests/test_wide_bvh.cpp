@@ -9,14 +9,17 @@
 #include "ray_generators.h"
 
 #include <catch2/catch.hpp>
+#include <tbb/global_control.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 #include <random>
 #include <sstream>
@@ -399,6 +402,52 @@ TEST_CASE("make_block_ray's triangle ray is the kernel's make_tri_ray, bit for b
   CHECK(mismatches == 0);
 }
 
+TEST_CASE("four-lane plane normals of the triangle blocks equal the kernel's, bit for bit", "[wide]") {
+  // Vertices whose edges have every exponent field (the scale's clamp at both ends, flushes to zero,
+  // denormals), coincide (zero edges, the unused lanes' case), overflow to infinity, or hold an
+  // infinity or a NaN (the lanes the kernel itself takes).
+  Rng rng(29);
+  size_t checked = 0, mismatches = 0;
+  auto coordinate = [&](int kind, uint32_t field) {
+    switch (kind) {
+      case 0: return 0.0f;
+      case 1: return -0.0f;
+      case 2: return kInf;
+      case 3: return std::numeric_limits<float>::quiet_NaN();
+      case 4: return 3.0e38f;
+      default: return float_with_field(rng, field);
+    }
+  };
+  for (int trial = 0; trial < 100000; ++trial) {
+    ls::TriBlock block{};
+    for (int l = 0; l < 4; ++l) {
+      // A lane's coordinates near one exponent field, so that their differences span the range.
+      const uint32_t base = uint32_t(rng.gen() % 255);
+      for (int p = 0; p < 3; ++p)
+        for (int a = 0; a < 3; ++a) {
+          const int kind = trial % 3 == 0 ? int(rng.gen() % 12) : 5;
+          const uint32_t field = uint32_t(std::clamp(int(base) + int(rng.gen() % 9) - 4, 0, 254));
+          block.v[p][a][l] = coordinate(kind, field);
+        }
+      if (trial % 11 == 1)  // a degenerate lane: two equal vertices, or all three
+        for (int a = 0; a < 3; ++a) block.v[1][a][l] = block.v[trial % 2 ? 2 : 0][a][l] = block.v[0][a][l];
+    }
+    ls::block_lanes::plane_normals(block);
+    for (int l = 0; l < 4; ++l) {
+      auto vertex = [&](int p) { return lsk::vec3(block.v[p][0][l], block.v[p][1][l], block.v[p][2][l]); };
+      const lsk::vec3 want = lsk::triangle_plane_normal(vertex(0), vertex(1), vertex(2));
+      ++checked;
+      bool ok = true;
+      for (int a = 0; a < 3; ++a)
+        ok = ok && ((std::isnan(want[a]) && std::isnan(block.n[a][l])) ||
+                    std::bit_cast<uint32_t>(want[a]) == std::bit_cast<uint32_t>(block.n[a][l]));
+      if (!ok && mismatches++ < 5) UNSCOPED_INFO("trial " << trial << " lane " << l);
+    }
+  }
+  CHECK(checked == 400000);
+  CHECK(mismatches == 0);
+}
+
 TEST_CASE("triangle blocks: every lane gives the scalar kernel's hit, from denormal to huge coordinates", "[wide]") {
   // The block test's rescale (max, exponent clamp to [-126, 126], flush rule) against
   // lsk::ray_triangle, one lane at a time: triangles whose offsets from the origin have exponents
@@ -569,6 +618,64 @@ void check_exact_tree() {
 TEST_CASE("exact wide tree: entries, leaves and boxes, 4 and 8 wide", "[wide]") {
   check_exact_tree<4>();
   check_exact_tree<8>();
+}
+
+// The exact tree and the blocks of `accel` built again, on one thread or on all.
+template <int W>
+std::pair<ls::ExactWideTree<W>, ls::TriangleBlocks> rebuild_fast_layout(const ls::Accel& a, int threads) {
+  std::unique_ptr<tbb::global_control> limit;
+  if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
+  ls::ExactWideTree<W> tree = ls::build_exact_wide_tree<W>(a.nodes, a.spec.line_space() ? a.node_ls : std::vector<uint32_t>{}, roots);
+  ls::TriangleBlocks blocks = ls::build_triangle_blocks<W>(a.nodes, a.tris, tree);
+  return {std::move(tree), std::move(blocks)};
+}
+
+template <int W>
+void check_layout_schedule_free(const ls::Accel& a) {
+  const auto [tree1, blocks1] = rebuild_fast_layout<W>(a, 1);
+  const auto [tree, blocks] = rebuild_fast_layout<W>(a, 0);
+  REQUIRE(tree.nodes.size() == tree1.nodes.size());
+  CHECK(std::memcmp(tree.nodes.data(), tree1.nodes.data(), tree.nodes.size() * sizeof(tree.nodes[0])) == 0);
+  CHECK(tree.entry_of == tree1.entry_of);
+  CHECK(tree.entries == tree1.entries);
+  REQUIRE(blocks.blocks.size() == blocks1.blocks.size());
+  CHECK(std::memcmp(blocks.blocks.data(), blocks1.blocks.data(), blocks.blocks.size() * sizeof(ls::TriBlock)) == 0);
+  CHECK(blocks.lane_of == blocks1.lane_of);
+  // Depth first: a wide node's inner children follow it, each subtree before the next lane's.
+  size_t misplaced = 0;
+  std::function<uint32_t(uint32_t)> end_of = [&](uint32_t w) {  // one past w's subtree
+    uint32_t next = w + 1;
+    for (int l = 0; l < W; ++l)
+      if (tree.nodes[w].child[l] != lsk::LS_INVALID && tree.nodes[w].count[l] == 0) {
+        misplaced += tree.nodes[w].child[l] != next;
+        next = end_of(tree.nodes[w].child[l]);
+      }
+    return next;
+  };
+  uint32_t next = 0;
+  std::vector<uint32_t> entry_nodes;
+  for (uint32_t e : tree.entry_of)
+    if (e != lsk::LS_INVALID) entry_nodes.push_back(e);
+  std::sort(entry_nodes.begin(), entry_nodes.end());
+  for (uint32_t e : entry_nodes) {
+    misplaced += e != next;
+    next = end_of(e);
+  }
+  CHECK(next == tree.nodes.size());
+  CHECK(misplaced == 0);
+}
+
+TEST_CASE("exact wide tree and triangle blocks: the same bytes on one thread as on all, depth first", "[wide]") {
+  // Large enough that the collapse and the SAH split into parallel tasks (subtrees over 4,096
+  // triangles); two-level structures take their objects as tasks.
+  const ls::Scene scene = ls::load_scene("builtin:generated:30000:12:5");
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3"}) {
+    INFO(s);
+    const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
+    check_layout_schedule_free<4>(a);
+    check_layout_schedule_free<8>(a);
+  }
 }
 
 TEST_CASE("wide BVH: the candidate search on the fast path stores the reference kernel's candidates, every shaft", "[wide]") {
