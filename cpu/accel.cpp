@@ -195,9 +195,11 @@ Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOpti
   // The fast path's wide trees need the Line Space's nodes, not its candidates: made before the
   // search, which then runs on it.
   const auto wide_start = std::chrono::steady_clock::now();
-  check_fast_path_budget(accel, options.wide_width, options.exact_width, options.ls.max_memory);
-  accel.fast = make_fast_tracer(accel, options.wide_width, options.exact_width);
-  accel.traversal = options.traversal;
+  if (options.fast_path) {
+    check_fast_path_budget(accel, options.wide_width, options.exact_width, options.ls.max_memory);
+    accel.fast = make_fast_tracer(accel, options.wide_width, options.exact_width);
+  }
+  accel.traversal = options.fast_path ? options.traversal : Traversal::Reference;
   accel.wide_build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wide_start).count();
   if (spec.line_space() && options.search_candidates) {
     search_line_space(accel.ls_options, accel);  // sets ls_info.seconds to the search's

@@ -66,6 +66,7 @@ struct AccelOptions {
   Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
   int wide_width = 4;                     // treelets (Line Space structures): 4 or 8, chosen by measurement
   int exact_width = 8;                    // the order-free walk's nodes: 4 or 8, chosen by measurement
+  bool fast_path = true;  // false: no fast path is made, trace_rays takes the reference (the GPU port's builds)
   AccelOptions() = default;
   AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
 };

@@ -9,6 +9,8 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace ls {
 
@@ -49,15 +51,24 @@ struct LsFlags {
   std::string traversal = "fast";
   int wide_width = AccelOptions{}.wide_width;
   int exact_width = AccelOptions{}.exact_width;
+  std::string refused_value;
+  std::vector<std::pair<std::string, const CLI::Option*>> refused_;  // a program without the fast path: its flags, refused when given
 
-  void add_to(CLI::App* app) {
-    app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
-        ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
-    app->add_option("--wide-width", wide_width, "treelet width of the fast path's ordered walk (Line Space structures): 4 or 8")
-        ->capture_default_str()->check(CLI::IsMember({4, 8}));
-    app->add_option("--exact-width", exact_width,
-                    "node width of the fast path's order-free walk (exact structures, below LS nodes): 4 or 8")
-        ->capture_default_str()->check(CLI::IsMember({4, 8}));
+  // fast_path_flags: the CPU fast path's flags; a program without that path (linespace-gpu) leaves
+  // them out, so that giving one is an error rather than silently ignored.
+  void add_to(CLI::App* app, bool fast_path_flags = true) {
+    if (fast_path_flags) {
+      app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
+          ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
+      app->add_option("--wide-width", wide_width, "treelet width of the fast path's ordered walk (Line Space structures): 4 or 8")
+          ->capture_default_str()->check(CLI::IsMember({4, 8}));
+      app->add_option("--exact-width", exact_width,
+                      "node width of the fast path's order-free walk (exact structures, below LS nodes): 4 or 8")
+          ->capture_default_str()->check(CLI::IsMember({4, 8}));
+    } else {  // parsed, then refused by options()
+      for (const char* flag : {"--traversal", "--wide-width", "--exact-width"})
+        refused_.emplace_back(flag, app->add_option(flag, refused_value)->group(""));  // group "": not in --help
+    }
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
@@ -74,6 +85,9 @@ struct LsFlags {
         ->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 24));
   }
   AccelOptions options() const {
+    for (const auto& [name, flag] : refused_)
+      if (flag->count() > 0)
+        throw InputError(name + " is a flag of linespace-cpu's fast path; this program traces with the shared kernels");
     AccelOptions o;
     o.ls.angle_degrees = float(angle);
     o.ls.further_rays = further_rays;

@@ -63,7 +63,7 @@ struct Commands {
 Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   app.require_subcommand(1);
   auto common = [&](CLI::App* cmd, bool builds) {
-    if (builds) v.ls.add_to(cmd);
+    if (builds) v.ls.add_to(cmd, info.fast_path_flags);
     if (info.device_flag)
       cmd->add_option("--device", v.device, "Vulkan device: index or part of its name (default: discrete GPU first)");
     cmd->add_option("--scene", v.scene, "scene file (.gltf .glb .obj .ply .off .stl) or builtin:NAME")->capture_default_str();

@@ -45,6 +45,7 @@ struct ProgramInfo {
   std::string name;            // "linespace-cpu"
   std::string description;     // the --help banner
   bool device_flag = false;    // --device NAME|INDEX on every subcommand (the GPU program)
+  bool fast_path_flags = true;  // --traversal, --wide-width, --exact-width: the CPU's fast path (not the GPU program)
   // Makes the backend once the command line is parsed, for the subcommands that need one.
   std::function<std::unique_ptr<Backend>(const std::string& device)> make_backend;
 };

@@ -68,6 +68,7 @@ Accel build_accel_gpu(const VulkanContext& context, const Scene& scene, const St
                       GpuSearchTiming* timing) {
   AccelOptions laid_out = options;
   laid_out.search_candidates = false;
+  laid_out.fast_path = false;  // the device traces with the shared kernels: the CPU's wide trees would be unused
   Accel accel = build_accel(scene, spec, laid_out);
   if (spec.line_space()) {
     search_candidates_gpu(context, accel, timing);

@@ -150,6 +150,7 @@ int main(int argc, char** argv) {
   info.name = "linespace-gpu";
   info.description = "linespace-gpu: exact and Line Space ray tracing on a Vulkan device";
   info.device_flag = true;
+  info.fast_path_flags = false;  // the device traces with the shared kernels
   info.make_backend = [](const std::string& device) { return std::make_unique<GpuBackend>(device); };
   return run_program(argc, argv, info);
 }

@@ -62,6 +62,10 @@ TEST_CASE("linespace-gpu bad input exits 2 with a one-line reason", "[gpu_cli]")
       "trace --rays " + temp("odd.rays").string() + " --hits " + temp("h").string(),
       "bench --structures f-ls:8",
       "frobnicate",
+      // The CPU fast path's flags: the device traces with the shared kernels, so they are refused.
+      "build --exact-width 4",
+      "bench --wide-width 8",
+      "render --traversal reference --size 8x8 --out " + temp("r").string(),
   };
   for (const std::string& args : cases) {
     const Run r = run(LINESPACE_GPU, args);
@@ -104,6 +108,8 @@ TEST_CASE("linespace-gpu build and render report the device and the CPU's sizes"
   CHECK_FALSE(jg.at("device").get<std::string>().empty());
   for (const char* key : {"triangles", "nodes", "ls_nodes", "shafts_per_ls", "empty_shafts", "bytes_total", "bytes_ls"})
     CHECK(jg.at(key) == jc.at(key));
+  CHECK(jg.at("bytes_wide") == 0);  // no CPU fast path is made for the device
+  CHECK(jc.at("bytes_wide") > 0);
   const std::string out = temp("render").string();
   const Run r = run(LINESPACE_GPU, "render --size 16x12 --spp 1 --bounces 1 --quiet --out " + out);
   INFO(r.err);

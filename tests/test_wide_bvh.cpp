@@ -268,6 +268,27 @@ TEST_CASE("wide BVH: trace_rays takes the fast path by default and the reference
   CHECK_THROWS_AS(ls::build_accel(scene, ls::parse_structure("bvh"), o), ls::InputError);
 }
 
+TEST_CASE("wide BVH: a build without the fast path (the GPU port's) traces with the reference, same hits", "[wide]") {
+  const ls::Scene scene = random_scene(5);
+  const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));
+  const std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::RayKind::Diffuse, 3000, 8);
+  for (const char* s : {"bvh", "2l-ls:2:3"}) {
+    INFO(s);
+    ls::AccelOptions o;
+    o.fast_path = false;
+    o.exact_width = 2;  // not checked: no fast path is made
+    const ls::Accel none = ls::build_accel(scene, ls::parse_structure(s), o);
+    CHECK(none.fast == nullptr);
+    CHECK(none.bytes_wide() == 0);
+    CHECK(none.traversal == ls::Traversal::Reference);
+    const ls::Accel with = ls::build_accel(scene, ls::parse_structure(s));
+    std::vector<lsk::Hit> a(rays.size()), b(rays.size());
+    ls::trace_rays(none, rays.data(), a.data(), rays.size(), false);
+    ls::trace_rays(with, rays.data(), b.data(), rays.size(), false);
+    CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0);
+  }
+}
+
 TEST_CASE("wide BVH: rays with infinite or NaN components take the ordered walk and agree", "[wide]") {
   const ls::Scene scene = random_scene(6);
   const float inf = kInf, nan = std::numeric_limits<float>::quiet_NaN();
