@@ -10,6 +10,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <memory>
 
 namespace ls {
 
@@ -36,14 +37,19 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   result.exact_width = options.exact_width;
   result.any_hit = any_hit;
 
-  // The structures stay built together for the timed runs: each is refused over what the ones
-  // before it left of the budget (memory_budget.h), so that together they stay within it.
+  // The rays, a hit array, the structures and Embree's scene stay in memory together for the timed
+  // runs: each structure, then Embree, is refused over what the ones before it left of the budget
+  // (memory_budget.h), so that together they stay within it.
   const size_t budget = memory_budget(options.ls.max_memory);
-  size_t held = 0;  // bytes of the structures built so far, their fast paths included
+  size_t held = rays.size() * (sizeof(lsk::Ray) + sizeof(lsk::Hit));  // then the structures built so far, fast paths included
+  if (held > budget)
+    throw InputError("bench's " + std::to_string(rays.size()) + " rays and their hits take " + mib_text(double(held)) +
+                     ", over the budget of " + mib_text(double(budget)) + ": use fewer rays (--count) or raise --max-memory");
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) {
-    const std::string held_by = "bench holds its structures at once, and the ones before '" + spec.name() + "' take " +
-                                mib_text(double(held)) + " of the budget of " + mib_text(double(budget)) + ": bench fewer --structures or raise --max-memory";
+    const std::string held_by = "bench holds its rays, hits and structures at once, and the rays, hits and structures before '" +
+                                spec.name() + "' take " + mib_text(double(held)) + " of the budget of " + mib_text(double(budget)) +
+                                ": bench fewer --structures or raise --max-memory";
     if (held >= budget) throw InputError(held_by);
     AccelOptions left = options;
     left.ls.max_memory = budget - held;
@@ -55,7 +61,17 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
     }
     held += built.back().bytes_total() + built.back().bytes_wide();
   }
-  EmbreeTracer embree(scene, embree_isa);
+  const std::string embree_held_by = "bench holds Embree's scene beside its rays, hits and structures, which take " +
+                                    mib_text(double(held)) + " of the budget of " + mib_text(double(budget)) +
+                                    ": bench fewer --structures or raise --max-memory";
+  if (held >= budget) throw InputError("no memory is left for Embree's scene (" + embree_held_by + ")");
+  std::unique_ptr<EmbreeTracer> made;
+  try {
+    made = std::make_unique<EmbreeTracer>(scene, embree_isa, budget - held);
+  } catch (const EmbreeOverBudget& e) {
+    throw InputError(std::string(e.what()) + " (" + embree_held_by + ")");
+  }
+  const EmbreeTracer& embree = *made;
   result.embree_isa = embree.isa();
 
   // Runs: per structure the fast path, then the reference; Embree last.

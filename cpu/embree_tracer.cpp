@@ -10,10 +10,12 @@
 // callback only records the message: throwing through Embree's C frames would be undefined.
 #include "embree_tracer.h"
 
+#include "memory_budget.h"
 #include "parallel.h"
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -29,6 +31,8 @@ struct EmbreeTracer::Impl {
   double build_seconds = 0.0;
   std::string isa;
   std::atomic<int64_t> bytes{0};
+  int64_t max_bytes = 0;  // 0: no limit
+  std::atomic<bool> over_limit{false};
   std::mutex error_mutex;
   std::string error;  // the first message the error callback reported, if any
 
@@ -44,9 +48,16 @@ struct EmbreeTracer::Impl {
       self->error = std::string(message ? message : "unknown error") + " (code " + std::to_string(int(code)) + ")";
   }
 
-  static bool on_memory(void* user, ssize_t bytes, bool /*post*/) {
-    static_cast<Impl*>(user)->bytes.fetch_add(int64_t(bytes), std::memory_order_relaxed);
-    return true;  // never refuse an allocation
+  // Counts Embree's memory; over max_bytes an allocation is refused, which cancels the current call
+  // (RTC_ERROR_OUT_OF_MEMORY).  A refused allocation that has not happened yet (post == false) is
+  // not counted, one that has is (Embree frees it later), as its manual page asks.
+  static bool on_memory(void* user, ssize_t bytes, bool post) {
+    Impl* self = static_cast<Impl*>(user);
+    const int64_t now = self->bytes.fetch_add(int64_t(bytes), std::memory_order_relaxed) + int64_t(bytes);
+    if (bytes <= 0 || self->max_bytes == 0 || now <= self->max_bytes) return true;
+    self->over_limit.store(true, std::memory_order_relaxed);
+    if (!post) self->bytes.fetch_sub(int64_t(bytes), std::memory_order_relaxed);
+    return false;
   }
 
   // Throws when Embree reported an error since the last check.
@@ -58,6 +69,9 @@ struct EmbreeTracer::Impl {
       message.swap(error);
     }
     if (code == RTC_ERROR_NONE && message.empty()) return;
+    if (over_limit.load(std::memory_order_relaxed))
+      throw EmbreeOverBudget("Embree's scene would take more than the " + mib_text(double(max_bytes)) +
+                             " left of the memory budget (" + what + ")");
     if (message.empty()) message = "error code " + std::to_string(int(code));
     throw InputError(std::string("Embree: ") + what + ": " + message);
   }
@@ -103,8 +117,9 @@ std::string embree_effective_isa(const std::string& isa) {
   return embree_isa_names()[asked == 0 || asked > host ? host : asked];
 }
 
-EmbreeTracer::EmbreeTracer(const Scene& scene, const std::string& isa) : impl_(std::make_unique<Impl>()) {
+EmbreeTracer::EmbreeTracer(const Scene& scene, const std::string& isa, size_t max_bytes) : impl_(std::make_unique<Impl>()) {
   Impl& im = *impl_;
+  im.max_bytes = int64_t(std::min(max_bytes, size_t(std::numeric_limits<int64_t>::max())));
   im.isa = embree_effective_isa(isa);
   // All hardware threads through TBB; the instruction set limited where asked (Embree's "isa=").
   const std::string config = isa == "best" ? std::string() : "isa=" + im.isa;

@@ -22,10 +22,17 @@ const std::vector<std::string>& embree_isa_names();
 // best this CPU has of Embree's targets where that is below it.
 std::string embree_effective_isa(const std::string& isa);
 
+// What EmbreeTracer throws when Embree's memory would pass its max_bytes.
+struct EmbreeOverBudget : InputError {
+  using InputError::InputError;
+};
+
 class EmbreeTracer {
  public:
-  // isa: one of embree_isa_names(); an unknown name is an InputError.
-  explicit EmbreeTracer(const Scene& scene, const std::string& isa = "best");
+  // isa: one of embree_isa_names(); an unknown name is an InputError.  max_bytes: 0 for no limit,
+  // else Embree's own memory may not pass it: the build is cancelled (its memory monitor) and the
+  // constructor throws EmbreeOverBudget, which names the limit.
+  explicit EmbreeTracer(const Scene& scene, const std::string& isa = "best", size_t max_bytes = 0);
   ~EmbreeTracer();
   EmbreeTracer(const EmbreeTracer&) = delete;
   EmbreeTracer& operator=(const EmbreeTracer&) = delete;

@@ -478,6 +478,23 @@ TEST_CASE("embree tracer: instances without triangles are skipped, ids kept", "[
   CHECK(hit.t == Approx(1.0f));
 }
 
+TEST_CASE("embree tracer: a memory limit cancels the build with the limit named, and is kept", "[embree]") {
+  const ls::Scene scene = ls::load_scene("builtin:generated:20000:7:3");
+  const ls::EmbreeTracer free_run(scene);
+  const size_t needed = free_run.bytes();
+  REQUIRE(needed > 100000);
+  try {
+    const ls::EmbreeTracer limited(scene, "best", needed / 2);  // less than the kept scene
+    FAIL("the build under half its memory was not cancelled");
+  } catch (const ls::EmbreeOverBudget& e) {
+    CHECK(std::string(e.what()).find("Embree's scene would take more than") != std::string::npos);
+    CHECK(std::string(e.what()).find("memory budget") != std::string::npos);
+  }
+  const ls::EmbreeTracer roomy(scene, "best", 64 * needed);  // room for the build's temporaries
+  CHECK(roomy.bytes() > needed / 2);  // its parallel build need not keep the same bytes each time
+  CHECK(roomy.bytes() <= 64 * needed);
+}
+
 TEST_CASE("embree agreement: builtin:cornell", "[embree]") {
   check_scene("builtin:cornell", ls::load_scene("builtin:cornell"), {ls::RayKind::Diffuse}, 1);
 }
