@@ -2,6 +2,7 @@
 
 #include "accel.h"
 #include "interrupt.h"
+#include "memory_budget.h"
 #include "parallel.h"
 
 #include <glm/gtc/packing.hpp>
@@ -213,15 +214,14 @@ void layout_line_space_nodes(const LsOptions& options, const BvhSubtrees& subtre
     estimate = double(estimate_line_space_bytes(placed.size(), accel.spec.subdivision));
   }
 
-  const size_t budget = options.max_memory ? options.max_memory : physical_memory_bytes() / 2;
+  const size_t budget = memory_budget(options.max_memory);
   if (estimate > double(budget)) {
     const std::string shape = accel.spec.line_space() && accel.spec.subdivision > 0 && options.objects.empty()
                                   ? std::to_string(placed.size()) + " LS nodes x " +
                                         std::to_string(lsk::ls_shaft_count(uint32_t(accel.spec.subdivision))) + " shafts"
                                   : std::to_string(placed.size()) + " LS nodes";
-    throw InputError("structure '" + accel.spec.name() + "': its Line Space would take about " +
-                     std::to_string(size_t(estimate) >> 20) + " MiB (" + shape + "), over the budget of " +
-                     std::to_string(budget >> 20) + " MiB: lower N or D, or raise --max-memory");
+    throw InputError("structure '" + accel.spec.name() + "': its Line Space would take about " + mib_text(estimate) + " (" +
+                     shape + "), over the budget of " + mib_text(double(budget)) + ": lower N or D, or raise --max-memory");
   }
 
   accel.node_ls.assign(accel.nodes.size(), lsk::LS_INVALID);

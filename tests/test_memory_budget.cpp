@@ -106,3 +106,17 @@ TEST_CASE("render buffers over the budget are refused with the size, the estimat
                     Contains("16384x16384") && Contains("MiB") && Contains("--size") && Contains("--max-memory"));
   CHECK_THROWS_AS(check_render_budget(16384, 16384, 64, size_t(4) << 30), InputError);
 }
+
+TEST_CASE("the Line Space layout re-checks the budget with its actual LS nodes, and names both in MiB", "[budget]") {
+  // build_accel's estimate is an upper bound made before the BVH exists; the layout checks again with
+  // the LS nodes it placed.  Called here directly with a budget the first check never saw.
+  const Scene scene = load_scene("builtin:cornell");
+  Accel accel = build_accel(scene, parse_structure("f-ls:3:8"));
+  REQUIRE(accel.ls_info.ls_nodes > 0);
+  LsOptions tight = accel.ls_options;
+  tight.max_memory = 1000000;  // 1 MB = 0.95 MiB: named as the refusals round it, up, "1 MiB"
+  CHECK_THROWS_WITH(layout_line_space(scene, tight, accel),
+                    Contains("structure 'f-ls:3:8': its Line Space would take about") &&
+                        Contains(std::to_string(accel.ls_info.ls_nodes) + " LS nodes x") && Contains("over the budget of 1 MiB") &&
+                        Contains("lower N or D, or raise --max-memory"));
+}
