@@ -52,7 +52,7 @@ struct LsFlags {
   int wide_width = AccelOptions{}.wide_width;
   int exact_width = AccelOptions{}.exact_width;
   std::string refused_value;
-  std::vector<std::pair<std::string, const CLI::Option*>> refused_;  // a program without the fast path: its flags, refused when given
+  std::vector<std::pair<std::string, const CLI::Option*>> refused_flags;  // a program without the fast path: its flags, refused when given
 
   // fast_path_flags: the CPU fast path's flags; a program without that path (linespace-gpu) leaves
   // them out, so that giving one is an error rather than silently ignored.
@@ -67,7 +67,7 @@ struct LsFlags {
           ->capture_default_str()->check(CLI::IsMember({4, 8}));
     } else {  // parsed, then refused by options()
       for (const char* flag : {"--traversal", "--wide-width", "--exact-width"})
-        refused_.emplace_back(flag, app->add_option(flag, refused_value)->group(""));  // group "": not in --help
+        refused_flags.emplace_back(flag, app->add_option(flag, refused_value)->group(""));  // group "": not in --help
     }
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
@@ -85,7 +85,7 @@ struct LsFlags {
         ->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 24));
   }
   AccelOptions options() const {
-    for (const auto& [name, flag] : refused_)
+    for (const auto& [name, flag] : refused_flags)
       if (flag->count() > 0)
         throw InputError(name + " is a flag of linespace-cpu's fast path; this program traces with the shared kernels");
     AccelOptions o;
