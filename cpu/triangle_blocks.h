@@ -74,9 +74,10 @@ LS_ALWAYS_INLINE void plane_normals(TriBlock& block) {
     const Float4 p0 = Float4::load_aligned(block.v[0][a]);
     f1[a] = Float4::load_aligned(block.v[1][a]) - p0;
     f2[a] = Float4::load_aligned(block.v[2][a]) - p0;
-    m = glm_max(m, glm_max(f1[a] & magnitude, f2[a] & magnitude));  // max is exact: any order
-    finite = finite && (f1[a] & magnitude) < Float4(std::numeric_limits<float>::infinity()) &&
-             (f2[a] & magnitude) < Float4(std::numeric_limits<float>::infinity());
+    const Float4 abs1 = f1[a] & magnitude, abs2 = f2[a] & magnitude;
+    m = glm_max(m, glm_max(abs1, abs2));  // max is exact: any order
+    const Float4 inf(std::numeric_limits<float>::infinity());
+    finite = finite && abs1 < inf && abs2 < inf;  // false for a NaN too
   }
   // unit_exponent(m): clamp(127 - field, -126, 126) (a denormal m has field 0).  Its 0 for m == 0
   // is not needed: every edge coordinate is then a signed zero, which any scale leaves as it is.
