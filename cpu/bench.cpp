@@ -3,8 +3,7 @@
 #include "accel.h"
 #include "embree_tracer.h"
 #include "memory_budget.h"
-
-#include <tbb/info.h>
+#include "thread_limit.h"
 
 #include <algorithm>
 #include <chrono>
@@ -29,7 +28,7 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
                       int repeats, const AccelOptions& options, bool any_hit, const std::string& embree_isa) {
   BenchResult result;
   result.rays = rays.size();
-  result.threads = tbb::info::default_concurrency();
+  result.threads = thread_count();
   result.repeats = std::max(1, repeats);
   result.cpu = cpu_model();
   result.isa = fast_path_isa();
@@ -44,11 +43,11 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   size_t held = rays.size() * (sizeof(lsk::Ray) + sizeof(lsk::Hit));  // then the structures built so far, fast paths included
   if (held > budget)
     throw InputError("bench's " + std::to_string(rays.size()) + " rays and their hits take " + mib_text(double(held)) +
-                     ", over the budget of " + mib_text(double(budget)) + ": use fewer rays (--count) or raise --max-memory");
+                     ", over the budget of " + mib_budget_text(double(budget)) + ": use fewer rays (--count) or raise --max-memory");
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) {
     const std::string held_by = "bench holds its rays, hits and structures at once, and the rays, hits and structures before '" +
-                                spec.name() + "' take " + mib_text(double(held)) + " of the budget of " + mib_text(double(budget)) +
+                                spec.name() + "' take " + mib_text(double(held)) + " of the budget of " + mib_budget_text(double(budget)) +
                                 ": bench fewer --structures or raise --max-memory";
     if (held >= budget) throw InputError(held_by);
     AccelOptions left = options;
@@ -62,7 +61,7 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
     held += built.back().bytes_total() + built.back().bytes_wide();
   }
   const std::string embree_held_by = "bench holds Embree's scene beside its rays, hits and structures, which take " +
-                                    mib_text(double(held)) + " of the budget of " + mib_text(double(budget)) +
+                                    mib_text(double(held)) + " of the budget of " + mib_budget_text(double(budget)) +
                                     ": bench fewer --structures or raise --max-memory";
   if (held >= budget) throw InputError("no memory is left for Embree's scene (" + embree_held_by + ")");
   std::unique_ptr<EmbreeTracer> made;

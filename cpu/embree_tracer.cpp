@@ -70,7 +70,7 @@ struct EmbreeTracer::Impl {
     }
     if (code == RTC_ERROR_NONE && message.empty()) return;
     if (over_limit.load(std::memory_order_relaxed))
-      throw EmbreeOverBudget("Embree's scene would take more than the " + mib_text(double(max_bytes)) +
+      throw EmbreeOverBudget("Embree's scene would take more than the " + mib_budget_text(double(max_bytes)) +
                              " left of the memory budget (" + what + ")");
     if (message.empty()) message = "error code " + std::to_string(int(code));
     throw InputError(std::string("Embree: ") + what + ": " + message);
@@ -121,7 +121,7 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, const std::string& isa, size_t ma
   Impl& im = *impl_;
   im.max_bytes = int64_t(std::min(max_bytes, size_t(std::numeric_limits<int64_t>::max())));
   im.isa = embree_effective_isa(isa);
-  // All hardware threads through TBB; the instruction set limited where asked (Embree's "isa=").
+  // The threads TBB may use (all, or --threads: thread_limit.h); the instruction set limited where asked (Embree's "isa=").
   const std::string config = isa == "best" ? std::string() : "isa=" + im.isa;
   im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
   if (!im.device)

@@ -221,7 +221,7 @@ void layout_line_space_nodes(const LsOptions& options, const BvhSubtrees& subtre
                                         std::to_string(lsk::ls_shaft_count(uint32_t(accel.spec.subdivision))) + " shafts"
                                   : std::to_string(placed.size()) + " LS nodes";
     throw InputError("structure '" + accel.spec.name() + "': its Line Space would take about " + mib_text(estimate) + " (" +
-                     shape + "), over the budget of " + mib_text(double(budget)) + ": lower N or D, or raise --max-memory");
+                     shape + "), over the budget of " + mib_budget_text(double(budget)) + ": lower N or D, or raise --max-memory");
   }
 
   accel.node_ls.assign(accel.nodes.size(), lsk::LS_INVALID);

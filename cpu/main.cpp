@@ -1,5 +1,5 @@
 // linespace-cpu: the command line of the CPU reference (DESIGN §9; the subcommands and flags are
-// cli_program.h's, shared with linespace-gpu).  Structures are built and traced on all CPU threads,
+// cli_program.h's, shared with linespace-gpu).  Structures are built and traced on all CPU threads (or --threads),
 // and bench runs Embree 3 beside them.
 #include "bench.h"
 #include "cli_program.h"
@@ -38,9 +38,9 @@ void print_bench(const BenchResult& r, bool json) {
               << "\n";
     return;
   }
-  std::printf("%zu rays (%s), %d threads, median of %d runs, %s\n", r.rays,
+  std::printf("%zu rays (%s), %d thread%s, median of %d runs, %s\n", r.rays,
               r.any_hit ? "occlusion: fast path and Embree; any hit: reference" : "closest hit",
-              r.threads, r.repeats, r.cpu.c_str());
+              r.threads, r.threads == 1 ? "" : "s", r.repeats, r.cpu.c_str());
   std::printf("fast path: %d-wide order-free BVH, %d-wide LS treelets, %s; reference: the scalar single-source kernels; "
               "Embree: %s\n",
               r.exact_width, r.wide_width, r.isa.c_str(), r.embree_isa.c_str());

@@ -12,7 +12,24 @@
 #include <vector>
 
 namespace ls {
-std::string mib_text(double bytes) { return std::to_string(uint64_t(std::ceil(bytes / double(1 << 20)))) + " MiB"; }
+namespace {
+
+// bytes in MiB rounded by `round` (std::ceil or std::floor) to whole MiB, or to tenths below 10 MiB.
+std::string mib_rounded(double bytes, double (*round)(double)) {
+  const double mib = bytes / double(1 << 20);
+  const double tenths = round(mib * 10.0);
+  if (tenths >= 100.0) return std::to_string(uint64_t(round(mib))) + " MiB";
+  const uint64_t t = uint64_t(tenths);
+  std::string text = std::to_string(t / 10u);
+  if (t % 10u != 0u) text += '.' + std::to_string(t % 10u);
+  return text + " MiB";
+}
+
+}  // namespace
+
+std::string mib_text(double bytes) { return mib_rounded(bytes, std::ceil); }
+
+std::string mib_budget_text(double bytes) { return mib_rounded(bytes, std::floor); }
 
 namespace {
 
@@ -87,7 +104,7 @@ void check_structure_budget(const Scene& scene, const StructureSpec& spec, const
   else if (spec.line_space())
     why += "Line Space " + mib_text(double(e.ls_bytes)) + ": up to " + std::to_string(e.ls_nodes_at_most) + " LS nodes" +
            (ls.objects.empty() ? " x " + std::to_string(lsk::ls_shaft_count(uint32_t(spec.subdivision))) + " shafts; " : "; ");
-  why += "BVH and triangles " + mib_text(double(e.bvh_bytes)) + "), over the budget of " + mib_text(double(budget)) + ": ";
+  why += "BVH and triangles " + mib_text(double(e.bvh_bytes)) + "), over the budget of " + mib_budget_text(double(budget)) + ": ";
   why += spec.budgeted       ? "lower --ls-budget or raise --max-memory"
          : spec.line_space() ? "lower N or D, raise --ls-min-triangles, or raise --max-memory"
                              : "use a smaller scene or raise --max-memory";
@@ -144,7 +161,7 @@ void check_fast_path_budget(const Accel& accel, int width, int exact_width, size
   if (built <= budget && fast <= budget - built) return;
   throw InputError("the fast path of structure '" + accel.spec.name() + "' (its wide trees and triangle blocks) would take up to " +
                    mib_text(double(fast)) + " beside the structure's " + mib_text(double(built)) + ", over the budget of " +
-                   mib_text(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
+                   mib_budget_text(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
 }
 
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces) {
@@ -160,7 +177,7 @@ void check_render_budget(uint32_t width, uint32_t height, int bounces, size_t ma
   if (estimate <= budget) return;
   throw InputError("render " + std::to_string(width) + "x" + std::to_string(height) + " with " + std::to_string(bounces) +
                    " bounces would take about " + mib_text(double(estimate)) + " of image buffers, over the budget of " +
-                   mib_text(double(budget)) + ": lower --size or --bounces, or raise --max-memory");
+                   mib_budget_text(double(budget)) + ": lower --size or --bounces, or raise --max-memory");
 }
 
 }  // namespace ls

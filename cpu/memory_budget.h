@@ -17,8 +17,12 @@ namespace ls {
 // max_memory in bytes, or half of the physical memory when 0.
 size_t memory_budget(size_t max_memory);
 
-// Bytes as the refusals name them: whole MiB, rounded up ("13 MiB").
+// Bytes as the refusals name them: whole MiB from 10 MiB on ("13 MiB"), tenths below ("0.9 MiB"), so
+// that a small budget does not read "0 MiB".  What would be taken is rounded up (mib_text) and a
+// budget, or what is left of one, down (mib_budget_text): a refusal's amount then always reads larger
+// than the budget it exceeds, never "5 MiB ... over the budget of 5 MiB".
 std::string mib_text(double bytes);
+std::string mib_budget_text(double bytes);
 
 // Upper bound of the bytes of a structure: BVH nodes, triangles and ids, the build's temporary
 // arrays, and for F-LS / 2L-LS the Line Space at min(2^D, triangles / min_triangles) LS nodes per

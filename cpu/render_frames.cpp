@@ -4,9 +4,9 @@
 #include "interrupt.h"
 #include "memory_budget.h"
 #include "render_output.h"
+#include "thread_limit.h"
 
 #include <nlohmann/json.hpp>
-#include <tbb/info.h>
 
 #include <algorithm>
 #include <charconv>
@@ -184,7 +184,7 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
                     {"top_level_update", top_level_mode_name(frames.top_level)},
                     {"flat_comparison", frames.flat_comparison},
                     {"device", device.empty() ? "cpu: " + cpu_model() : device},
-                    {"threads", tbb::info::default_concurrency()},
+                    {"threads", thread_count()},
                     {"initial_build", initial}};
 
   std::error_code ec;

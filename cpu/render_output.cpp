@@ -3,8 +3,7 @@
 #include "bench.h"
 #include "image_output.h"
 #include "interrupt.h"
-
-#include <tbb/info.h>
+#include "thread_limit.h"
 
 #include <filesystem>
 #include <fstream>
@@ -81,7 +80,7 @@ nlohmann::json render_report(const RenderResult& result, const RenderReportConte
               {"bounces", int(result.bounces.size()) - 1},
               {"seed", context.seed},
               {"device", context.device.empty() ? "cpu: " + cpu_model() : context.device},
-              {"threads", tbb::info::default_concurrency()},
+              {"threads", thread_count()},
               {"seconds", result.seconds},
               {"primary", {{"rays", primary.extension_rays + primary.shadow_rays}, {"seconds", primary.trace_seconds}}},
               {"indirect",

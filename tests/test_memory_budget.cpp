@@ -114,9 +114,35 @@ TEST_CASE("the Line Space layout re-checks the budget with its actual LS nodes, 
   Accel accel = build_accel(scene, parse_structure("f-ls:3:8"));
   REQUIRE(accel.ls_info.ls_nodes > 0);
   LsOptions tight = accel.ls_options;
-  tight.max_memory = 1000000;  // 1 MB = 0.95 MiB: named as the refusals round it, up, "1 MiB"
+  tight.max_memory = 1000000;  // 1 MB = 0.95 MiB: a budget is named rounded down, in tenths, "0.9 MiB"
   CHECK_THROWS_WITH(layout_line_space(scene, tight, accel),
                     Contains("structure 'f-ls:3:8': its Line Space would take about") &&
-                        Contains(std::to_string(accel.ls_info.ls_nodes) + " LS nodes x") && Contains("over the budget of 1 MiB") &&
+                        Contains(std::to_string(accel.ls_info.ls_nodes) + " LS nodes x") && Contains("over the budget of 0.9 MiB") &&
                         Contains("lower N or D, or raise --max-memory"));
+}
+
+TEST_CASE("amounts are named rounded up and budgets rounded down, so an amount over a budget reads larger", "[budget]") {
+  constexpr double mib = double(1 << 20);
+  CHECK(mib_text(0.0) == "0 MiB");
+  CHECK(mib_budget_text(0.0) == "0 MiB");
+  CHECK(mib_text(mib) == "1 MiB");  // exact values stay as they are, in both
+  CHECK(mib_budget_text(mib) == "1 MiB");
+  CHECK(mib_text(1e6) == "1 MiB");  // 0.954 MiB
+  CHECK(mib_budget_text(1e6) == "0.9 MiB");
+  CHECK(mib_text(4.5e6) == "4.3 MiB");  // 4.29 MiB
+  CHECK(mib_budget_text(4.5e6) == "4.2 MiB");
+  CHECK(mib_text(9.99 * mib) == "10 MiB");  // tenths end at 10 MiB
+  CHECK(mib_budget_text(9.99 * mib) == "9.9 MiB");
+  CHECK(mib_budget_text(10.0 * mib) == "10 MiB");
+  CHECK(mib_text(4e9) == "3815 MiB");
+  CHECK(mib_budget_text(4e9) == "3814 MiB");
+  // The refusals' property: whenever an amount exceeds a budget, its text's number is the larger.
+  // Rounding both up failed it ("5 MiB ... over the budget of 5 MiB" at --max-memory 4.5 on 5.1 MB).
+  auto number = [](const std::string& text) { return std::stod(text.substr(0, text.find(' '))); };
+  for (double budget = 0.05 * mib; budget < 300.0 * mib; budget *= 1.37)
+    for (double over : {1.0, 1.001, 1.01, 1.1, 1.5}) {
+      const double amount = budget * over + 1.0;
+      INFO(budget << " " << amount);
+      CHECK(number(mib_text(amount)) > number(mib_budget_text(budget)));
+    }
 }
