@@ -2,10 +2,11 @@
 # Traversal speed beside Embree 3 on the same rays: per scene and structure, the fast path's MRays/s,
 # its ratio to Embree's rtcIntersect1 (rtcOccluded1 for KIND=shadow) measured in the same run, and its
 # ratio to our scalar reference path; medians over RUNS runs of `linespace-cpu bench` (each run
-# itself the median of REPEAT timings, all threads).
+# itself the median of REPEAT timings, on THREADS threads).
 #   scripts/bench-traversal.sh [SCENE ...]    default: the built-in scenes and assets/real/*.glb
 #   RUNS=3 REPEAT=3 COUNT=200000 KIND=diffuse STRUCTURES=bvh,2l-bvh,f-ls:8:6,2l-ls:4:6
 #   LS_FLAGS="--ls-min-triangles 0"           Line Space flags for every run (the paper's setting)
+#   THREADS=0                                 bench --threads: 0 all the CPUs, 2 "two cores" on any machine
 #   EMBREE_ISA=best                           Embree's instruction set (bench --embree-isa; sse2 matches
 #                                             the portable build's SSE2)
 #   LINESPACE_CPU=build/release/cpu/linespace-cpu
@@ -20,6 +21,7 @@ KIND=${KIND:-diffuse}
 STRUCTURES=${STRUCTURES:-bvh,2l-bvh,f-ls:8:6,2l-ls:4:6}
 LS_FLAGS=${LS_FLAGS---ls-min-triangles 0}
 EMBREE_ISA=${EMBREE_ISA:-best}
+THREADS=${THREADS:-0}
 [[ -x $BIN ]] || { echo "bench-traversal: $BIN is not built (scripts/run-demo.sh builds it)" >&2; exit 2; }
 [[ $RUNS =~ ^[1-9][0-9]*$ ]] || { echo "bench-traversal: RUNS=$RUNS is not a positive integer" >&2; exit 2; }
 scenes=("$@")
@@ -36,7 +38,7 @@ for scene in "${scenes[@]}"; do
     echo "  $scene: run $run of $RUNS" >&2
     # shellcheck disable=SC2086  # LS_FLAGS is a list of flags
     "$BIN" bench --scene "$scene" --kind "$KIND" --count "$COUNT" --repeat "$REPEAT" --structures "$STRUCTURES" \
-      --embree-isa "$EMBREE_ISA" $LS_FLAGS --json >> "$tmp"
+      --embree-isa "$EMBREE_ISA" --threads "$THREADS" $LS_FLAGS --json >> "$tmp"
     echo >> "$tmp"
   done
   python3 - "$scene" "$tmp" <<'EOF'
