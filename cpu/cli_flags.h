@@ -38,6 +38,15 @@ inline Size parse_size(const std::string& text) {
   return s;
 }
 
+// --threads: the CPU threads a run may use (thread_limit.h), on every subcommand that does CPU work.
+struct ThreadsFlag {
+  int threads = 0;  // 0: all the process's CPUs
+  void add_to(CLI::App* app) {
+    app->add_option("--threads", threads, "CPU threads for builds, traces and Embree (0: all the process's CPUs)")
+        ->capture_default_str();
+  }
+};
+
 // Line Space options shared by every subcommand that builds a structure.
 struct LsFlags {
   double angle = LsOptions{}.angle_degrees;

@@ -25,7 +25,7 @@ namespace {
 // Every option of every subcommand, with its default.
 struct Values {
   std::string device;
-  int threads = 0;  // 0: all the process's CPUs (thread_limit.h)
+  ThreadsFlag threads;
   std::string scene = "builtin:cornell";
   std::string structure = "bvh";
   bool json = false;
@@ -69,8 +69,7 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
     if (info.device_flag)
       cmd->add_option("--device", v.device, "Vulkan device: index or part of its name (default: discrete GPU first)");
     cmd->add_option("--scene", v.scene, "scene file (.gltf .glb .obj .ply .off .stl) or builtin:NAME")->capture_default_str();
-    cmd->add_option("--threads", v.threads, "CPU threads for builds, traces and Embree (0: all the process's CPUs)")
-        ->capture_default_str();
+    v.threads.add_to(cmd);
   };
   Commands c;
   c.build = app.add_subcommand("build", "build a structure and print its size and build time");
@@ -234,7 +233,7 @@ void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v)
 }
 
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {
-  const ThreadLimit threads(v.threads);  // first: a bad count is refused before any work
+  const ThreadLimit threads(v.threads.threads);  // first: a bad count is refused before any work
   if (*c.build || *c.trace) check_budget_flag({parse_structure(v.structure)}, v);
   if (*c.render) {
     std::vector<StructureSpec> specs = parse_schedule(v.schedule).per_bounce;

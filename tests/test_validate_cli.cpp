@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 22> cases = {
+  const std::array<std::string, 24> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -44,6 +44,8 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "policy --start-bounces 4 --bounces 3",
       "policy --structure octree",
       "policy --repeat 0",
+      "rmse --threads -2",
+      "sweep --threads 1048576",  // more threads than this process's CPUs
   };
   for (const std::string& c : cases) {
     INFO(c);

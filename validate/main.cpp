@@ -9,6 +9,7 @@
 #include "policy_study.h"
 #include "rmse_study.h"
 #include "sweep.h"
+#include "thread_limit.h"
 
 #include <CLI/CLI.hpp>
 
@@ -82,6 +83,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string scene_spec = "builtin:cornell", device = "cpu", out_dir;
   LsFlags ls_flags;
+  ThreadsFlag threads_flag;
   ImageFlags image_flags;
 
   std::string structures = "f-ls:8:6,2l-ls:4:6";
@@ -95,6 +97,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
   image_flags.add_to(rmse_cmd);
   ls_flags.add_to(rmse_cmd);
+  threads_flag.add_to(rmse_cmd);
 
   std::string families = "f-ls,2l-ls", depths = "0,2,4,6,8", subdivisions = "4,6,8", angles = "45";
   int start_bounce = 1;
@@ -111,6 +114,7 @@ int main(int argc, char** argv) {
   sweep_cmd->add_flag("--no-plot", no_plot, "write the data only");
   image_flags.add_to(sweep_cmd);
   ls_flags.add_to(sweep_cmd);
+  threads_flag.add_to(sweep_cmd);
 
   std::string scenes = "builtin:cornell", tables = "2,3,4", paper_n = "6,10";
   auto* paper_cmd = app.add_subcommand("paper", "the paper's Tables 2, 3 and 4 on our scenes, beside the paper's figures");
@@ -123,6 +127,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
   image_flags.add_to(paper_cmd);
   ls_flags.add_to(paper_cmd);
+  threads_flag.add_to(paper_cmd);
 
   std::string uniform = "2l-ls:0:10,2l-ls:4:6";
   auto* budget_cmd = app.add_subcommand("budget", "2l-ls:auto against uniform 2l-ls:D:N of the same memory: RMSE, MRays/s, the choice");
@@ -132,6 +137,7 @@ int main(int argc, char** argv) {
   budget_cmd->add_option("--out", out_dir, "folder for budget.{md,csv,json}")->default_val("out/budget");
   image_flags.add_to(budget_cmd);
   ls_flags.add_to(budget_cmd);
+  threads_flag.add_to(budget_cmd);
   std::string policy_structure = "f-ls:8:6", thresholds = "0.05,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.99", start_bounces;
   int policy_repeats = 1;
   auto* policy_cmd = app.add_subcommand("policy", "bounce policy against throughput policy (render --throughput-switch) at equal speed");
@@ -145,6 +151,7 @@ int main(int argc, char** argv) {
   policy_cmd->add_option("--out", out_dir, "folder for policy.{md,csv,json}")->default_val("out/policy");
   image_flags.add_to(policy_cmd);
   ls_flags.add_to(policy_cmd);
+  threads_flag.add_to(policy_cmd);
 
   // CPU-versus-GPU cross-checks (issue 5): exit 1 on any difference.
   validate::CrossCheckCommand check;
@@ -156,6 +163,7 @@ int main(int argc, char** argv) {
     cmd->add_option("--scale", check.scale, "scale the scene first (numerical extremes)")->capture_default_str();
     cmd->add_option("--offset", check_offset, "then move it by X Y Z")->expected(3);
     ls_flags.add_to(cmd);
+    threads_flag.add_to(cmd);
   };
   auto* candidates_cmd = app.add_subcommand("candidates", "Line Space candidates built on CPU and GPU, compared shaft by shaft");
   add_check_flags(candidates_cmd);
@@ -177,6 +185,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    const ThreadLimit threads(threads_flag.threads);  // first: a bad count is refused before any work
     for (size_t i = 0; i < check_offset.size() && i < 3; ++i) check.offset[i] = check_offset[i];
     if (*candidates_cmd) return validate::run_candidates_command(check, ls_flags.options());
     if (*hits_cmd) return validate::run_hits_command(check, ls_flags.options());
