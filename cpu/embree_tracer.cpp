@@ -121,7 +121,8 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, const std::string& isa, size_t ma
   Impl& im = *impl_;
   im.max_bytes = int64_t(std::min(max_bytes, size_t(std::numeric_limits<int64_t>::max())));
   im.isa = embree_effective_isa(isa);
-  // The threads TBB may use (all, or --threads: thread_limit.h); the instruction set limited where asked (Embree's "isa=").
+  // The threads TBB may use (all, or --threads: thread_limit.h); the instruction set limited where
+  // asked (Embree's "isa=").
   const std::string config = isa == "best" ? std::string() : "isa=" + im.isa;
   im.device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
   if (!im.device)
