@@ -272,8 +272,8 @@ TEST_CASE("render writes every image and a report", "[cli]") {
 // loaded machine or under ASan): an attempted build would take hours or be killed for memory.
 TEST_CASE("over-budget structures and renders exit 2 within seconds naming estimate, budget and flag", "[cli]") {
   // 4000 MB = 3814.7 MiB, 16 MB = 15.3 MiB, 5 MB = 4.77 MiB: budgets are named rounded down, in
-  // tenths below 10 MiB (memory_budget.h).  The fourth: the BVH's estimate
-  // fits 5 MB, the structure and its fast path's bound do not (memory_budget.h).
+  // tenths below 10 MiB.  The fourth: the BVH's estimate fits 5 MB, the structure and its fast
+  // path's bound do not (memory_budget.h).
   const std::array<std::tuple<std::string, std::string, std::string>, 5> cases = {{
       {"build --scene builtin:instances --structure f-ls:8:64 --max-memory 4000", "budget of 3814 MiB", "lower N or D"},
       {"build --scene builtin:instances --structure f-ls:30:10 --max-memory 4000", "budget of 3814 MiB", "lower N or D"},
