@@ -243,13 +243,37 @@ void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t
   trace_rays(accel, rays, hits, count, any_hit, counters, accel.traversal);
 }
 
+std::vector<uint8_t> line_space_subtrees(const Accel& accel) {
+  std::vector<uint8_t> in_ls;
+  if (accel.node_ls.empty()) return in_ls;
+  in_ls.assign(accel.nodes.size(), 0);
+  std::vector<uint32_t> stack;
+  for (size_t n = 0; n != accel.nodes.size(); ++n) {
+    if (accel.node_ls[n] == lsk::LS_INVALID || in_ls[n]) continue;
+    stack.assign(1, uint32_t(n));
+    while (!stack.empty()) {
+      const uint32_t i = stack.back();
+      stack.pop_back();
+      in_ls[i] = 1;
+      const lsk::BvhNode& node = accel.nodes[i];
+      if (node.count == 0) {
+        stack.push_back(node.first);
+        stack.push_back(node.first + 1);
+      }
+    }
+  }
+  return in_ls;
+}
+
 namespace {
 
 // trace_rays and trace_occlusion: TBB over chunks of rays, each chunk on its own copy of the trace
 // context, counters per thread and summed once.
 void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit, bool occlusion,
                   lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
-  const lsk::TraceContext context = accel.context();
+  lsk::TraceContext context = accel.context();
+  const std::vector<uint8_t> in_ls = work ? line_space_subtrees(accel) : std::vector<uint8_t>();
+  if (!in_ls.empty()) context.node_in_ls = in_ls.data();
   const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
   // Per-thread counters, summed once at the end: no lock on the hot path.
   tbb::enumerable_thread_specific<lsk::LsCounters> per_thread(lsk::LsCounters{});
@@ -268,6 +292,8 @@ void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size
       w.box_tests += local.trace_work.box_tests;
       w.triangle_tests += local.trace_work.triangle_tests;
       w.lookups += local.ls_counters.lookups;
+      w.box_tests_in_ls += local.trace_work.box_tests_in_ls;
+      w.triangle_tests_in_ls += local.trace_work.triangle_tests_in_ls;
     }
   });
   if (counters)
@@ -277,6 +303,8 @@ void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size
       work->box_tests += w.box_tests;
       work->triangle_tests += w.triangle_tests;
       work->lookups += w.lookups;
+      work->box_tests_in_ls += w.box_tests_in_ls;
+      work->triangle_tests_in_ls += w.triangle_tests_in_ls;
     }
 }
 

@@ -90,11 +90,23 @@ bool trace_bvh_reference(lsk::TraceContext& context, uint32_t root, const lsk::v
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters = nullptr);
 // The reference traversal's work over a batch (the 2l-ls:auto pilot's model, ls_budget.h): box and
-// triangle tests counted by the kernels, Line Space lookups by the counters.  The fast path counts its
-// triangle tests only (its box tests are SIMD lanes the kernels do not see).
+// triangle tests counted by the kernels, Line Space lookups by the counters.  The fast path counts
+// only what it hands to the reference kernels (its own box tests are SIMD lanes the kernels do not
+// see).  The *_in_ls part was done in Line Space nodes' subtrees (line_space_subtrees).
 struct TraceWorkTotals {
   uint64_t box_tests = 0, triangle_tests = 0, lookups = 0;
+  uint64_t box_tests_in_ls = 0, triangle_tests_in_ls = 0;
 };
+// That work in box tests: a triangle test and a Line Space lookup weighed by instruction counts of the
+// reference traversal fitted over seven structures (README, "2l-ls:auto").
+constexpr double kTriangleTestWork = 2.3;
+constexpr double kLookupWork = 5.7;
+inline double work_units(uint64_t box_tests, uint64_t triangle_tests, uint64_t lookups) {
+  return double(box_tests) + kTriangleTestWork * double(triangle_tests) + kLookupWork * double(lookups);
+}
+// Per node of accel.nodes: 1 in the subtree of a node with a Line Space (that node included), else
+// 0.  Empty for a structure without a Line Space.
+std::vector<uint8_t> line_space_subtrees(const Accel& accel);
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work = nullptr);
 

@@ -96,7 +96,7 @@ struct LsFlags {
   AccelOptions options() const {
     for (const auto& [name, flag] : refused_flags)
       if (flag->count() > 0)
-        throw InputError(name + " is a flag of linespace-cpu's fast path; this program traces with the shared kernels");
+        throw InputError(name + " is a flag of linespace-cpu's fast path; this command traces with the shared kernels");
     AccelOptions o;
     o.ls.angle_degrees = float(angle);
     o.ls.further_rays = further_rays;

@@ -24,10 +24,6 @@ namespace {
 
 constexpr uint32_t kPilotSeed = 0x5eed1234u;  // the pilot's rays are the same for every plan of a scene
 constexpr double kMoveTolerance = 1e-3;        // of the scene's diagonal: a hit that moved less is right
-// The work of a triangle test and of a Line Space lookup, in box tests: instruction counts of the
-// reference traversal fitted over seven structures (README, "2l-ls:auto").
-constexpr double kTriangleWeight = 2.3;
-constexpr double kLookupWeight = 5.7;
 constexpr double kNegligibleWork = 0.01;  // saved work per pilot ray below which an option buys nothing
 
 struct Traced {
@@ -41,7 +37,7 @@ Traced trace_counted(const Accel& accel, const std::vector<lsk::Ray>& rays, bool
   out.hits.resize(rays.size());
   TraceWorkTotals w;
   trace_rays(accel, rays.data(), out.hits.data(), rays.size(), any_hit, nullptr, Traversal::Reference, &w);
-  out.work = double(w.box_tests) + kTriangleWeight * double(w.triangle_tests) + kLookupWeight * double(w.lookups);
+  out.work = work_units(w.box_tests, w.triangle_tests, w.lookups);
   return out;
 }
 

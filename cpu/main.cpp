@@ -78,9 +78,13 @@ class CpuBackend : public Backend {
     TraceWorkTotals work;
     const bool reference = accel.traversal == Traversal::Reference;
     trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, counters, accel.traversal, reference ? &work : nullptr);
-    if (reference && note)
+    if (reference && note) {
       *note = "; reference work: " + std::to_string(work.box_tests) + " box tests, " + std::to_string(work.triangle_tests) +
               " triangle tests, " + std::to_string(work.lookups) + " lookups";
+      if (accel.spec.line_space())
+        *note += " (below the Line Space nodes: " + std::to_string(work.box_tests_in_ls) + " box tests, " +
+                 std::to_string(work.triangle_tests_in_ls) + " triangle tests)";
+    }
     return hits;
   }
   RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures, const RenderOptions& options,

@@ -8,6 +8,8 @@
 #include "kernels/ray_box.h"
 #include "kernels/ray_triangle.h"
 
+#include <cstdint>
+
 namespace lsk {
 
 struct TraceContext {
@@ -25,7 +27,19 @@ struct TraceContext {
   uint ls_enabled = 0;
   float ls_cos2 = -1.0f;
   LsCounters ls_counters{};  // the shader keeps these in a private variable too
-  TraceWork trace_work{};    // box and triangle tests of the reference traversal (the shader's are dead)
+  TraceWork trace_work{};    // box and triangle tests of the reference traversal (shaders count nothing)
+  // Per node of nodes[], non-zero in a Line Space node's subtree (line_space_subtrees(), accel.h):
+  // where the work is also counted as *_in_ls.  Null: nothing is.
+  const uint8_t* node_in_ls = nullptr;
+
+  void count_work(uint node, uint boxes, uint triangles) {
+    trace_work.box_tests += boxes;
+    trace_work.triangle_tests += triangles;
+    if (node_in_ls && node != LS_INVALID && node_in_ls[node]) {
+      trace_work.box_tests_in_ls += boxes;
+      trace_work.triangle_tests_in_ls += triangles;
+    }
+  }
 
 #include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"

@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 24> cases = {
+  const std::array<std::string, 30> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -46,6 +46,12 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "policy --repeat 0",
       "rmse --threads -2",
       "sweep --threads 1048576",  // more threads than this process's CPUs
+      "bound --structures bvh",   // an exact structure has nothing to bound
+      "bound --structures f-ls:3:4,2l-bvh",
+      "bound --kind shadow",
+      "bound --count 0",
+      "bound --rays /nonexistent.rays",
+      "bound --traversal fast",  // the study always counts on the reference kernels
   };
   for (const std::string& c : cases) {
     INFO(c);
@@ -74,6 +80,28 @@ TEST_CASE("linespace-validate rmse writes rmse.json with the documented keys and
   for (const char* f : {"rmse.md", "rmse.csv", "reference.png", "f-ls_4_4_from_bounce_1_heatmap.png",
                         "2l-ls_0_4_from_bounce_2_side_by_side.png"})
     REQUIRE(fs::file_size(out / f) > 0);
+}
+
+TEST_CASE("linespace-validate bound writes bound.json whose bounds follow from its work counts", "[cli]") {
+  const fs::path out = temp("bound");
+  const Run r = validate("bound --scene builtin:cornell --structures f-ls:3:4,2l-ls:0:3 --count 2000 --seed 3 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  REQUIRE(r.out.find("| f-ls:3:4 vs bvh |") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "bound.json"));
+  REQUIRE(j["ray_count"] == 2000);
+  REQUIRE(j["rows"].size() == 2);
+  REQUIRE(j["rows"][1]["exact_structure"] == "2l-bvh");
+  for (const auto& row : j["rows"]) {
+    const double exact = row["exact_work_per_ray"], oracle = row["oracle_work_per_ray"], traced = row["ls_work_per_ray"];
+    REQUIRE(exact > 0.0);
+    REQUIRE(row["bound"].get<double>() == Approx(exact / oracle));
+    REQUIRE(row["achieved"].get<double>() == Approx(exact / traced));
+    const auto& walk = row["exact_walk"];
+    REQUIRE(walk["box_tests_in_ls"].get<uint64_t>() < walk["box_tests"].get<uint64_t>());
+    REQUIRE(exact * 2000 == Approx(walk["box_tests"].get<double>() + 2.3 * walk["triangle_tests"].get<double>()));
+  }
+  for (const char* f : {"bound.md", "bound.csv"}) REQUIRE(fs::file_size(out / f) > 0);
 }
 
 TEST_CASE("linespace-validate sweep writes the data and the trade-off plot", "[cli]") {

@@ -1,12 +1,15 @@
 // linespace-validate: measures what the Line Space's approximation costs in image error and buys in
 // speed and memory (DESIGN §7, §9).
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
+#include "bound_study.h"
 #include "budget_study.h"
 #include "cli_flags.h"
 #include "cross_check.h"
 #include "load_scene.h"
 #include "paper_tables.h"
 #include "policy_study.h"
+#include "ray_files.h"
+#include "ray_generators.h"
 #include "rmse_study.h"
 #include "sweep.h"
 #include "thread_limit.h"
@@ -153,6 +156,22 @@ int main(int argc, char** argv) {
   ls_flags.add_to(policy_cmd);
   threads_flag.add_to(policy_cmd);
 
+  std::string bound_structures = "f-ls:8:6,2l-ls:4:6", bound_rays, bound_kind = "diffuse";
+  size_t bound_count = 200000;
+  uint32_t bound_seed = 1;
+  auto* bound_cmd = app.add_subcommand("bound", "the traversal work a Line Space could save at most (an exact, free lookup) "
+                                                "against what it saves, on the same rays (CPU reference kernels)");
+  bound_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
+  bound_cmd->add_option("--structures", bound_structures, "comma-separated Line Space structures")->capture_default_str();
+  bound_cmd->add_option("--rays", bound_rays, "ray file (default: --count rays of --kind made here)");
+  bound_cmd->add_option("--kind", bound_kind, "rays to make: diffuse, primary or random")
+      ->capture_default_str()->check(CLI::IsMember({"diffuse", "primary", "random"}));
+  bound_cmd->add_option("--count", bound_count, "rays to make")->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 26));
+  bound_cmd->add_option("--seed", bound_seed)->capture_default_str();
+  bound_cmd->add_option("--out", out_dir, "folder for bound.{md,csv,json}")->default_val("out/bound");
+  ls_flags.add_to(bound_cmd, false);  // always the reference kernels: they count their work
+  threads_flag.add_to(bound_cmd);
+
   // CPU-versus-GPU cross-checks (issue 5): exit 1 on any difference.
   validate::CrossCheckCommand check;
   std::vector<float> check_offset;
@@ -245,6 +264,26 @@ int main(int argc, char** argv) {
       std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\nwrote %s/{policy.md, policy.csv, policy.json}\n", scene_spec.c_str(),
                   settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
                   study.markdown().c_str(), out_dir.c_str());
+    } else if (*bound_cmd) {
+      const std::vector<StructureSpec> specs = parse_structure_list(bound_structures);
+      AccelOptions accel_options = ls_flags.options();
+      accel_options.fast_path = false;
+      const Scene scene = load_scene(scene_spec);
+      std::vector<lsk::Ray> rays;
+      std::string rays_name = bound_rays;
+      if (bound_rays.empty()) {
+        rays = generate_rays(scene, build_accel(scene, parse_structure("bvh"), accel_options), parse_ray_kind(bound_kind),
+                             bound_count, bound_seed);
+        rays_name = bound_kind + ", " + std::to_string(bound_count) + ", seed " + std::to_string(bound_seed);
+      } else {
+        rays = read_rays(bound_rays);
+      }
+      const BoundStudy study = run_bound_study(scene, scene_spec, rays, rays_name, specs, accel_options, log_line);
+      write_bound_study(out_dir, study);
+      std::printf("%s, %zu rays (%s); work a ray in box tests (+ %.1f a triangle test, %.1f a lookup), reference kernels\n\n%s\n"
+                  "wrote %s/{bound.md, bound.csv, bound.json}\n",
+                  scene_spec.c_str(), study.ray_count, rays_name.c_str(), kTriangleTestWork, kLookupWork,
+                  study.table().markdown().c_str(), out_dir.c_str());
     } else if (*paper_cmd) {
       PaperOptions options;
       options.scenes = scene_list(scenes);

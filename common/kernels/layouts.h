@@ -91,10 +91,14 @@ struct LsCounters {
 };
 
 // What a trace did, counted by the reference traversal (traverse_bvh.h): the work model of the Line
-// Space budget's pilot (cpu/ls_budget.h).  Never read back from a device: the shaders' copy is dead.
+// Space budget's pilot (cpu/ls_budget.h) and of `linespace-validate bound`.  C++ only: the shaders
+// count nothing.  The *_in_ls part was done at nodes in a Line Space node's subtree, the LS node
+// included: the exact work below the lookups.
 struct TraceWork {
   uint box_tests;
   uint triangle_tests;
+  uint box_tests_in_ls;
+  uint triangle_tests_in_ls;
 };
 
 // A pinhole camera: world position, orthonormal frame, tan(vertical fov / 2), image size.

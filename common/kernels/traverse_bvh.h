@@ -11,17 +11,18 @@
 //   instances[]      InstanceRecord, in top-level BVH order (2L only)
 //   node_ls[]        uint      LS node of each BVH node, or LS_INVALID (LS structures only)
 //   ls_enabled       uint      non-zero: use the Line Space (see ls_lookup.h for the rest)
-//   trace_work       TraceWork box and triangle tests, counted (C++ reads them; shaders ignore them)
+//   count_work(node, boxes, triangles)  counts the box and triangle tests made at nodes[node]
+//                    (LS_INVALID: at no object node, e.g. the top level): C++ sums them into a
+//                    TraceWork, split at the Line Space nodes; a shader's is empty
 // Ties at equal t go to the lower (instance, triangle), so the answer does not depend on the order in
 // which the structure visits triangles.
 
 LS_CONST int LS_STACK_SIZE = 64;  // the builder caps BVH depth below this
 
-// Tests the triangles [first, first + count) of a leaf (the CPU's wide traversal shares it).  Returns
+// Tests the triangles [first, first + count) of a leaf (the caller counts them: count_work).  Returns
 // true when any_hit is set and a hit was found (the caller stops).
 LS_FN bool trace_leaf(uint first, uint count, IN(TriRay) tri_ray, float tmin, uint instance, bool any_hit,
                       INOUT(Hit) hit, INOUT(uint) hit_prim) {
-  trace_work.triangle_tests += count;
   for (uint i = first; i < first + count; ++i) {
     Triangle tri = tris[i];
     float t;
@@ -65,7 +66,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
   float stack_t[LS_STACK_SIZE];
   int sp = 0;
   float t_root;
-  trace_work.box_tests += 1u;
+  count_work(LS_INVALID, 1u, 0u);  // the root's box: the walk's entry, never below a Line Space node
   if (!ray_box(origin, inv_dir, tmin, hit.t, nodes[root].lo, nodes[root].hi, t_root)) return false;
   uint current = root;
   while (true) {
@@ -79,13 +80,14 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
     if (!descend) {
       // answered by the Line Space: continue with the stack
     } else if (node.count > 0u) {
+      count_work(current, 0u, node.count);
       if (trace_leaf(node.first, node.count, tri_ray, tmin, instance, any_hit, hit, hit_prim)) return true;
     } else {
       uint left = node.first;
       uint right = node.first + 1u;
       float t_left;
       float t_right;
-      trace_work.box_tests += 2u;
+      count_work(current, 2u, 0u);
       bool hit_left = ray_box(origin, inv_dir, tmin, hit.t, nodes[left].lo, nodes[left].hi, t_left);
       bool hit_right = ray_box(origin, inv_dir, tmin, hit.t, nodes[right].lo, nodes[right].hi, t_right);
       if (hit_left && hit_right) {
@@ -131,7 +133,7 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
   float stack_t[LS_STACK_SIZE];
   int sp = 0;
   float t_root;
-  trace_work.box_tests += 1u;
+  count_work(LS_INVALID, 1u, 0u);
   bool pending = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[0].lo, top_nodes[0].hi, t_root);
   uint current = 0u;
   while (pending) {
@@ -149,7 +151,7 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
       uint right = node.first + 1u;
       float t_left;
       float t_right;
-      trace_work.box_tests += 2u;
+      count_work(LS_INVALID, 2u, 0u);
       bool hit_left = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[left].lo, top_nodes[left].hi, t_left);
       bool hit_right = ray_box(ray.origin, inv_dir, ray.tmin, hit.t, top_nodes[right].lo, top_nodes[right].hi, t_right);
       if (hit_left && hit_right) {

@@ -36,7 +36,7 @@ layout(push_constant) uniform Params {
 uint ls_enabled = pc.ls_enabled;
 float ls_cos2 = pc.ls_cos2;
 LsCounters ls_counters;
-TraceWork trace_work;  // counted by the kernels, never read: the compiler drops it
+void count_work(uint node, uint boxes, uint triangles) {}  // the CPU's work counters (traverse_bvh.h)
 
 #include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"

@@ -29,7 +29,7 @@ layout(std430, binding = 11) buffer Hits { Hit hits[]; };
 layout(push_constant) uniform P { uint ls_enabled; uint ls_n; float ls_cos2; uint two_level; } pc;
 uint ls_enabled = pc.ls_enabled; float ls_cos2 = pc.ls_cos2;
 LsCounters ls_counters;
-TraceWork trace_work;
+void count_work(uint node, uint boxes, uint triangles) {}
 #include "kernels/ls_lookup.h"
 #include "kernels/traverse_bvh.h"
 #include "kernels/ls_candidate_search.h"
