@@ -160,6 +160,7 @@ lsk::TraceContext Accel::context() const {
     c.ls_enabled = 1;
     const double a = double(ls_options.angle_degrees) * 3.14159265358979323846 / 180.0;
     c.ls_cos2 = ls_options.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
+    c.ls_reverse = ls_options.reverse_behind ? 1u : 0u;
   }
   return c;
 }

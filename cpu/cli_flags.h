@@ -53,6 +53,7 @@ struct LsFlags {
   int further_rays = LsOptions{}.further_rays;
   uint32_t min_triangles = LsOptions{}.min_triangles;
   std::string candidates = "compact";
+  std::string behind = "exact";
   double max_memory_mb = 0.0;
   double ls_budget_mb = 0.0;
   size_t ls_budget_rays = LsOptions{}.budget_rays;
@@ -80,6 +81,9 @@ struct LsFlags {
     }
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+    app->add_option("--ls-behind", behind,
+                    "a plane hit behind the origin: exact (traverse the subtree) or reverse (the reverse shaft's candidate answers)")
+        ->capture_default_str()->check(CLI::IsMember({"exact", "reverse"}));
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
         ->capture_default_str()->check(CLI::Range(0, 1024));
     app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
@@ -99,6 +103,7 @@ struct LsFlags {
         throw InputError(name + " is a flag of linespace-cpu's fast path; this command traces with the shared kernels");
     AccelOptions o;
     o.ls.angle_degrees = float(angle);
+    o.ls.reverse_behind = behind == "reverse";
     o.ls.further_rays = further_rays;
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";

@@ -28,6 +28,7 @@ struct LsOptions {
   // Defaults chosen by measurement: see README, "Line Space parameters".
   int further_rays = 0;          // search rays after the midpoint ray
   float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
+  bool reverse_behind = false;   // --ls-behind reverse: a plane hit behind the origin asks the reverse shaft (ls_lookup.h)
   uint32_t min_triangles = 8;    // subtrees with fewer triangles get no LS (0: the paper's behaviour)
   bool paper_candidates = false; // 4-byte candidates instead of the compact 1/2/4-byte local index
   size_t max_memory = 0;         // refuse above this estimate (0: half of physical memory)

@@ -43,7 +43,8 @@ std::vector<std::pair<std::string, std::string>> render_identity(const PartialHe
 
 std::string ls_flags_text(const LsOptions& o) {
   return "angle=" + float_text(o.angle_degrees) + " further_rays=" + std::to_string(o.further_rays) +
-         " min_triangles=" + std::to_string(o.min_triangles) + " candidates=" + (o.paper_candidates ? "paper" : "compact");
+         " min_triangles=" + std::to_string(o.min_triangles) + " candidates=" + (o.paper_candidates ? "paper" : "compact") +
+         " behind=" + (o.reverse_behind ? "reverse" : "exact");
 }
 
 std::string partial_stem(const std::string& selection) {

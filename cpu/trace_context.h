@@ -26,6 +26,7 @@ struct TraceContext {
   const uvec4* tri_normals = nullptr;
   uint ls_enabled = 0;
   float ls_cos2 = -1.0f;
+  uint ls_reverse = 0;  // --ls-behind reverse (ls_lookup.h)
   LsCounters ls_counters{};  // the shader keeps these in a private variable too
   TraceWork trace_work{};    // box and triangle tests of the reference traversal (shaders count nothing)
   // Per node of nodes[], non-zero in a Line Space node's subtree (line_space_subtrees(), accel.h):

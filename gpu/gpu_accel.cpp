@@ -17,6 +17,7 @@ GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
   const lsk::TraceContext c = accel.context();  // the CPU's parameters, so both sides agree
   params_.ls_enabled = c.ls_enabled;
   params_.ls_cos2 = c.ls_cos2;
+  params_.ls_reverse = c.ls_reverse;
   params_.two_level = accel.spec.two_level() ? 1u : 0u;
 }
 

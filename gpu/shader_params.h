@@ -13,7 +13,7 @@ struct ShaderParams {
   uint32_t any_hit = 0;
   uint32_t first = 0;
   uint32_t count = 0;
-  float inv_n = 0.0f;
+  uint32_t ls_reverse = 0;
   uint32_t further_rays = 0;
   uint32_t search_instance = 0;
   uint32_t first_ls = 0;

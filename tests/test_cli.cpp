@@ -66,7 +66,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 29> cases = {
+  const std::array<std::string, 30> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -93,6 +93,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "build --structure 2l-ls:auto --ls-budget 0.001",      // below the fixed part
       "build --structure 2l-ls:auto --ls-budget 10 --ls-budget-rays 0",
       "build --exact-width 16",
+      "build --ls-behind sideways",
       "bench --exact-width 0 --count 10",
       "build --threads -1",
       "bench --threads 1048576 --count 10",  // more threads than this process's CPUs

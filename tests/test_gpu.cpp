@@ -154,6 +154,17 @@ TEST_CASE("GPU hits equal the CPU's bit for bit for all four structures closest 
   for (const char* s : {"bvh", "2l-bvh", "f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random);
 }
 
+TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse", "[gpu]") {
+  AccelOptions reverse = paper();
+  reverse.ls.reverse_behind = true;
+  const Scene cornell = load_scene("builtin:cornell");
+  const std::vector<lsk::Ray> diffuse = diffuse_rays(cornell, 20000, 3);
+  for (const char* s : {"f-ls:3:6", "2l-ls:2:6", "2l-ls:0:10"}) require_hits_equal(cornell, s, diffuse, reverse);
+  const Scene objects = load_scene("builtin:generated:1200:3:5");
+  const std::vector<lsk::Ray> random = random_rays(objects, 20000, 4);  // origins inside LS boxes
+  for (const char* s : {"f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random, reverse);
+}
+
 TEST_CASE("GPU hits equal the CPU's at the extremes - flat boxes and scales 1e-20 and 1e20 and offset 1e6", "[gpu]") {
   const Scene plane = plane_scene(16);
   const std::vector<lsk::Ray> on_plane = random_rays(plane, 5000, 8);

@@ -2,6 +2,7 @@
 #include "accel.h"
 #include "load_scene.h"
 #include "ray_generators.h"
+#include "trace_context.h"
 #include "kernels/line_space.h"
 
 #include <catch2/catch.hpp>
@@ -367,6 +368,198 @@ TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes inc
     const std::vector<lsk::Hit> any = trace_all(a, rays, true);
     for (size_t i = 0; i < rays.size(); ++i)
       if (any[i].triangle != lsk::LS_INVALID) REQUIRE((any[i].t >= rays[i].tmin && any[i].t <= rays[i].tmax));
+  }
+}
+
+TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, and nothing is refused as behind", "[line_space]") {
+  const Scene scene = single_mesh_scene(random_soup(3000, 17));
+  std::mt19937 rng(23);
+  std::vector<lsk::Ray> rays = random_rays(20000, 29, glm::vec3(0.0f), glm::vec3(1.0f));
+  for (lsk::Ray& r : rays) {
+    r.tmin = 0.05f * uniform(rng);
+    r.tmax = r.tmin + 0.5f * uniform(rng);
+  }
+  AccelOptions reverse = angle(89.0f);
+  reverse.ls.reverse_behind = true;
+  for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
+    INFO(name);
+    lsk::LsCounters exact_counters{}, reverse_counters{};
+    trace_all(build_accel(scene, parse_structure(name), angle(89.0f)), rays, false, &exact_counters);
+    const Accel a = build_accel(scene, parse_structure(name), reverse);
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &reverse_counters);
+    REQUIRE(exact_counters.refused_behind > 0);
+    CHECK(reverse_counters.refused_behind == 0);
+    // The behind refusals became answers: more accepted or empty, the same lookups before them.
+    CHECK(reverse_counters.accepted + reverse_counters.empty > exact_counters.accepted + exact_counters.empty);
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (hits[i].triangle != lsk::LS_INVALID) REQUIRE((hits[i].t >= rays[i].tmin && hits[i].t <= rays[i].tmax));
+    const std::vector<lsk::Hit> any = trace_all(a, rays, true);
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (any[i].triangle != lsk::LS_INVALID) REQUIRE((any[i].t >= rays[i].tmin && any[i].t <= rays[i].tmax));
+  }
+  // A refusal angle of 0 still refuses everything: the exact structure's hits.
+  AccelOptions none = angle(0.0f);
+  none.ls.reverse_behind = true;
+  REQUIRE(same_bits(trace_all(build_accel(scene, parse_structure("f-ls:3:6"), none), rays),
+                    trace_all(build_accel(scene, parse_structure("bvh"), paper()), rays)));
+}
+
+TEST_CASE("--ls-behind reverse: from inside the box the reverse shaft's candidate answers, or says nothing is ahead", "[line_space]") {
+  // Two parallel planes z = 0 and z = 1 and a wall at x = -0.9 that makes the box reach z = -1 .. 2,
+  // so that neither plane lies on a face of the Line Space box.
+  Mesh m;
+  auto add_quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 n) {
+    const uint32_t base = uint32_t(m.positions.size());
+    for (const glm::vec3& p : {a, b, c, d}) {
+      m.positions.push_back(p);
+      m.normals.push_back(n);
+    }
+    m.triangles.push_back(glm::uvec3(base, base + 1, base + 2));
+    m.triangles.push_back(glm::uvec3(base, base + 2, base + 3));
+  };
+  for (float z : {0.0f, 1.0f}) add_quad({-1, -1, z}, {1, -1, z}, {1, 1, z}, {-1, 1, z}, {0, 0, 1});
+  add_quad({-0.9f, -1, -1}, {-0.9f, 1, -1}, {-0.9f, 1, 2}, {-0.9f, -1, 2}, {1, 0, 0});
+  const Scene scene = single_mesh_scene(m);
+  auto ray = [](glm::vec3 o, glm::vec3 d) {
+    lsk::Ray r;
+    r.origin = o;
+    r.dir = glm::normalize(d);
+    r.tmin = 0.0f;
+    r.tmax = lsk::ls_infinity();
+    return r;
+  };
+  const std::vector<lsk::Ray> rays = {
+      ray({0.5f, 0.1f, 1e-4f}, {0.2f, 0.1f, 1.0f}),          // leaves the lower plane upwards: meets the upper one
+      ray({0.4f, -0.2f, 1.0f - 1e-4f}, {-0.1f, 0.2f, -1.0f}), // leaves the upper plane downwards: meets the lower one
+      ray({0.5f, 0.1f, 1.0f + 1e-4f}, {0.2f, 0.1f, 1.0f}),   // leaves the upper plane upwards: nothing ahead
+      ray({0.3f, 0.3f, -1e-4f}, {0.1f, -0.1f, -1.0f}),       // leaves the lower plane downwards: nothing ahead
+  };
+  const Accel exact = build_accel(scene, parse_structure("bvh"), paper());
+  const std::vector<lsk::Hit> want = trace_all(exact, rays);
+  REQUIRE(want[0].triangle != lsk::LS_INVALID);
+  REQUIRE(want[1].triangle != lsk::LS_INVALID);
+  REQUIRE(want[2].triangle == lsk::LS_INVALID);
+  REQUIRE(want[3].triangle == lsk::LS_INVALID);
+  for (const char* name : {"f-ls:0:4", "f-ls:0:6", "2l-ls:0:5"}) {
+    INFO(name);
+    AccelOptions reverse = angle(45.0f);
+    reverse.ls.reverse_behind = true;
+    const Accel by_exact = build_accel(scene, parse_structure(name), angle(45.0f));
+    const Accel by_reverse = build_accel(scene, parse_structure(name), reverse);
+    REQUIRE(by_reverse.ls_info.ls_nodes == 1);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      INFO("ray " << i);
+      const std::vector<lsk::Ray> one = {rays[i]};
+      lsk::LsCounters e{}, r{};
+      const lsk::Hit got_exact = trace_all(by_exact, one, false, &e)[0];
+      const lsk::Hit got = trace_all(by_reverse, one, false, &r)[0];
+      REQUIRE(e.refused_behind == 1);  // every ray starts behind its shaft's first candidate
+      REQUIRE(r.refused_behind == 0);
+      REQUIRE(got_exact.t == want[i].t);  // refused: the subtree traversed exactly
+      if (i < 2) {
+        REQUIRE(r.accepted == 1);  // the reverse shaft's candidate is the plane ahead
+        REQUIRE(got.triangle != lsk::LS_INVALID);
+        REQUIRE(got.t == Approx(want[i].t).epsilon(1e-5));
+      } else {
+        REQUIRE(r.empty == 1);  // the reverse shaft's candidate is the plane the ray leaves
+        REQUIRE(got.triangle == lsk::LS_INVALID);
+      }
+    }
+  }
+}
+
+TEST_CASE("--ls-behind reverse decides as documented, on a hand-made Line Space", "[line_space]") {
+  // One LS box [-1, 1]^2 x [-1, 2], N = 4.  Shafts starting on the -Z face hold the plane z = 0 (L),
+  // those starting on +Z the triangle U under test, every other shaft is empty.  The rays start just
+  // above L, so their shaft's candidate L lies behind them and the reverse shaft's is U (or empty).
+  const uint32_t n = 4;
+  lsk::LsNode node{};
+  node.lo = glm::vec3(-1.0f, -1.0f, -1.0f);
+  node.hi = glm::vec3(1.0f, 1.0f, 2.0f);
+  node.scale = float(n) / (node.hi - node.lo);
+  node.n = n;
+  node.inv_n = 1.0f / float(n);
+  node.bytes = 4;
+  node.range_count = 2;
+  std::vector<uint32_t> candidates(lsk::ls_shaft_count(n));
+  for (uint32_t shaft = 0; shaft < candidates.size(); ++shaft) {
+    uint32_t start, end;
+    lsk::ls_shaft_patches(shaft, n, start, end);
+    const uint32_t face = start / (n * n);
+    candidates[shaft] = face == 4 ? 0u : face == 5 ? 1u : lsk::LS_INVALID;
+  }
+  auto plane = [](glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+    lsk::Triangle t;
+    t.v0 = glm::vec4(a, 1.0f);
+    t.v1 = glm::vec4(b, 1.0f);
+    t.v2 = glm::vec4(c, 1.0f);
+    return t;
+  };
+  auto horizontal = [&](float z) { return plane({-1, -1, z}, {3, -1, z}, {-1, 3, z}); };
+  const uint32_t up = 0u, along_x = 0x7fffu;  // octahedral codes of (0, 0, 1) and (1, 0, 0)
+  const std::vector<uint32_t> ids = {0, 1}, instances = {0, 0};
+  struct Case {
+    const char* what;
+    lsk::Triangle u;
+    uint32_t u_normal;
+    glm::vec3 dir;
+    float current_t;
+    uint32_t answer;  // with --ls-behind reverse
+    uint32_t counter_offset;  // the LsCounters field it counts in
+  };
+  using C = lsk::TraceContext;
+  const glm::vec3 upwards(0.2f, 0.1f, 1.0f);
+  const std::vector<Case> cases = {
+      {"the plane ahead answers", horizontal(1.0f), up, upwards, lsk::ls_infinity(), C::LS_ACCEPTED, offsetof(lsk::LsCounters, accepted)},
+      {"within half a patch: the surface the ray leaves", horizontal(0.05f), up, upwards, lsk::ls_infinity(), C::LS_EMPTY,
+       offsetof(lsk::LsCounters, empty)},
+      {"past the box's exit: no surface in the box", horizontal(5.0f), up, upwards, lsk::ls_infinity(), C::LS_EMPTY,
+       offsetof(lsk::LsCounters, empty)},
+      {"beyond the current hit: refused", horizontal(1.0f), up, upwards, 0.5f, C::LS_FALLBACK, offsetof(lsk::LsCounters, refused_beyond)},
+      {"past the refusal angle: refused", plane({0.8f, -1, -1}, {0.8f, 3, -1}, {0.8f, -1, 3}), along_x, upwards, lsk::ls_infinity(),
+       C::LS_FALLBACK, offsetof(lsk::LsCounters, refused_angle)},
+      {"an empty reverse shaft (it starts on +X)", horizontal(1.0f), up, glm::vec3(0.5f, 0.0f, 0.6f), lsk::ls_infinity(), C::LS_EMPTY,
+       offsetof(lsk::LsCounters, empty)},
+  };
+  for (const Case& k : cases) {
+    INFO(k.what);
+    const std::vector<lsk::Triangle> tris = {horizontal(0.0f), k.u};
+    const std::vector<glm::uvec4> normals = {glm::uvec4(up), glm::uvec4(k.u_normal)};
+    for (uint32_t reverse : {0u, 1u}) {
+      C c;
+      c.tris = tris.data();
+      c.tri_ids = ids.data();
+      c.tri_instances = instances.data();
+      c.ls_nodes = &node;
+      c.ls_candidates = candidates.data();
+      c.tri_normals = normals.data();
+      c.ls_cos2 = 0.5f;  // 45 degrees
+      c.ls_reverse = reverse;
+      const glm::vec3 origin(0.5f, 0.1f, 1e-4f), dir = glm::normalize(k.dir);
+      lsk::Hit hit{};
+      hit.t = k.current_t;
+      hit.instance = hit.triangle = lsk::LS_INVALID;
+      uint32_t prim = lsk::LS_INVALID;
+      const uint32_t answer = c.ls_lookup(0, origin, dir, lsk::safe_reciprocal(dir), 0.0f, lsk::LS_INVALID, hit, prim);
+      uint32_t counted;
+      std::memcpy(&counted, reinterpret_cast<const char*>(&c.ls_counters) + k.counter_offset, sizeof counted);
+      if (reverse == 0u) {  // the documented default: behind the origin, refused
+        CHECK(answer == C::LS_FALLBACK);
+        CHECK(c.ls_counters.refused_behind == 1u);
+        continue;
+      }
+      CHECK(answer == k.answer);
+      CHECK(counted == 1u);
+      CHECK(c.ls_counters.lookups == 1u);
+      CHECK(c.ls_counters.refused_behind == 0u);
+      if (answer == C::LS_ACCEPTED) {
+        CHECK(prim == 1u);
+        CHECK(hit.triangle == 1u);
+        CHECK(hit.t == Approx((1.0f - 1e-4f) / dir.z).epsilon(1e-6));
+      } else {
+        CHECK(hit.triangle == lsk::LS_INVALID);
+      }
+    }
   }
 }
 

@@ -218,6 +218,25 @@ TEST_CASE("wide BVH: same answers at refusal angles 0 and 89 degrees and with sm
       }
 }
 
+TEST_CASE("wide BVH: same answers and counters with --ls-behind reverse", "[wide]") {
+  for (const char* scene_name : {"builtin:cornell", "builtin:generated:30000:12:5"}) {
+    const ls::Scene scene = ls::load_scene(scene_name);
+    const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));
+    for (const char* kind : {"diffuse", "random", "shadow"}) {
+      const std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::parse_ray_kind(kind), 3000, 9);
+      for (int width : {4, 8})
+        for (const char* s : {"f-ls:4:4", "f-ls:8:6", "2l-ls:2:4", "2l-ls:0:6"}) {
+          ls::AccelOptions o = options(width);
+          o.ls.reverse_behind = true;
+          const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), o);
+          const std::string what = std::string(scene_name) + ", " + kind + " rays, reverse";
+          CHECK(require_same(a, rays, false, what) > 0);
+          CHECK(require_same(a, rays, true, what) > 0);
+        }
+    }
+  }
+}
+
 TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degenerate rays", "[wide]") {
   const ls::Scene scene = random_scene(4);
   Rng rng(99);

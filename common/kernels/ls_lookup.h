@@ -1,8 +1,8 @@
 // The Line Space lookup during traversal (DESIGN §3), a *context* file like traverse_bvh.h: it reads
 //   ls_nodes[] LsNode, ls_candidates[] uint, tri_normals[] uvec4 (octahedral vertex normals),
-//   tris[], tri_ids[], tri_instances[], and the parameter ls_cos2 (cos^2 of the refusal angle;
-//   negative: refuse everything, empty shafts included) and the counters ls_counters.  N is the
-//   LS node's own (LsNode.n).
+//   tris[], tri_ids[], tri_instances[], the parameters ls_cos2 (cos^2 of the refusal angle;
+//   negative: refuse everything, empty shafts included) and ls_reverse (non-zero: --ls-behind
+//   reverse, below), and the counters ls_counters.  N is the LS node's own (LsNode.n).
 //
 // Decided cases: the shaft comes from where the ray's *line* enters and leaves the LS box, so an
 // origin inside the box still finds its shaft.  An empty shaft means no hit in the subtree.  A
@@ -11,6 +11,15 @@
 // origin, beyond tmax, or farther than a hit already found), when the line runs along a face of the
 // box (no shaft), or when the angle between the ray and the candidate's vertex normals extrapolated
 // to the plane hit exceeds the refusal angle.
+//
+// --ls-behind reverse (ls_reverse): a plane hit behind the origin is not refused.  The shaft's
+// candidate is the first surface its line meets from the start patch; the *reverse* shaft's (end
+// patch to start patch, stored anyway) is the last, the one a ray from inside the box meets going
+// on.  So the reverse shaft's candidate answers instead, as an infinite plane like the first.  Its
+// plane hit within half a patch (half the line's chord through the box over N) of tmin, or behind
+// it, is the surface the ray leaves; past the line's exit from the box it is no surface in the box:
+// either way the shaft holds nothing ahead of the ray (empty, no hit in the subtree), and so does an
+// empty reverse shaft.  Otherwise beyond the current t, parallel or past the angle: refused as above.
 
 LS_CONST uint LS_FALLBACK = 0u;
 LS_CONST uint LS_EMPTY = 1u;
@@ -43,6 +52,53 @@ LS_FN uint ls_candidate(IN(LsNode) ls, uint shaft) {
   return local == mask ? LS_INVALID : ls.range_first + local;
 }
 
+// What ls_plane_hit found: the plane hit is usable, or why not.
+LS_CONST uint LS_PLANE_HIT = 0u;
+LS_CONST uint LS_PLANE_PARALLEL = 1u;
+LS_CONST uint LS_PLANE_BEHIND = 2u;
+LS_CONST uint LS_PLANE_BEYOND = 3u;
+LS_CONST uint LS_PLANE_ANGLE = 4u;
+
+// The candidate tris[prim] as an infinite plane: its hit t in [tmin, tmax] and the barycentrics
+// there, and the refusal angle's test on the vertex normals extrapolated to it.
+LS_FN uint ls_plane_hit(uint prim, IN(vec3) origin, IN(vec3) dir, float tmin, float tmax, OUT(float) t_hit, OUT(float) u_hit,
+                        OUT(float) v_hit) {
+  t_hit = 0.0f;
+  u_hit = 0.0f;
+  v_hit = 0.0f;
+  Triangle tri = tris[prim];
+  vec3 p0 = vec3(tri.v0);
+  precise vec3 e1 = vec3(tri.v1) - p0;
+  precise vec3 e2 = vec3(tri.v2) - p0;
+  int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
+  vec3 e1s = scale_pow2(e1, ke);
+  vec3 e2s = scale_pow2(e2, ke);
+  precise vec3 n = cross(e1s, e2s);
+  precise float denom = dot_in_order(dir, n);
+  if (denom == 0.0f || dot_in_order(n, n) == 0.0f) return LS_PLANE_PARALLEL;
+  precise float t = dot_in_order(p0 - origin, n) / denom;
+  t_hit = t;
+  if (!(t >= tmin)) return LS_PLANE_BEHIND;
+  if (!(t <= tmax)) return LS_PLANE_BEYOND;
+  // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
+  precise vec3 q = origin + dir * t - p0;
+  precise float nn = dot_in_order(n, n);
+  vec3 qs = scale_pow2(q, ke);
+  precise float b1 = dot_in_order(cross(qs, e2s), n) / nn;
+  precise float b2 = dot_in_order(cross(e1s, qs), n) / nn;
+  precise float b0 = 1.0f - b1 - b2;
+  u_hit = b1;
+  v_hit = b2;
+  uvec4 packed = tri_normals[prim];
+  precise vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
+  precise float c = dot_in_order(dir, ne);
+  precise float ne2 = dot_in_order(ne, ne);
+  precise float lhs = c * c;
+  precise float rhs = ls_cos2 * dot_in_order(dir, dir) * ne2;
+  if (ne2 == 0.0f || lhs < rhs) return LS_PLANE_ANGLE;
+  return LS_PLANE_HIT;
+}
+
 // One lookup at an LS node: LS_ACCEPTED (hit updated), LS_EMPTY (skip the subtree) or LS_FALLBACK
 // (traverse the subtree exactly).
 LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, float tmin, uint instance,
@@ -67,47 +123,41 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
     ls_counters.empty += 1u;
     return LS_EMPTY;
   }
-  Triangle tri = tris[prim];
-  vec3 p0 = vec3(tri.v0);
-  precise vec3 e1 = vec3(tri.v1) - p0;
-  precise vec3 e2 = vec3(tri.v2) - p0;
-  int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
-  vec3 e1s = scale_pow2(e1, ke);
-  vec3 e2s = scale_pow2(e2, ke);
-  precise vec3 n = cross(e1s, e2s);
-  precise float denom = dot_in_order(dir, n);
-  if (denom == 0.0f || dot_in_order(n, n) == 0.0f) {
+  float t;
+  float u;
+  float v;
+  uint found = ls_plane_hit(prim, origin, dir, tmin, hit.t, t, u, v);
+  if (found == LS_PLANE_BEHIND && ls_reverse != 0u) {
+    uint start_patch;
+    uint end_patch;
+    ls_shaft_patches(shaft, ls.n, start_patch, end_patch);
+    prim = ls_candidate(ls, ls_shaft_index(end_patch, start_patch, ls.n));
+    precise float half_patch = 0.5f * ls.inv_n * (t_out - t_in);
+    precise float ahead = tmin + half_patch;
+    if (prim != LS_INVALID) found = ls_plane_hit(prim, origin, dir, ahead, hit.t, t, u, v);
+    if (prim == LS_INVALID || found == LS_PLANE_BEHIND || (found != LS_PLANE_PARALLEL && t > t_out)) {
+      ls_counters.empty += 1u;
+      return LS_EMPTY;
+    }
+  }
+  if (found == LS_PLANE_PARALLEL) {
     ls_counters.refused_parallel += 1u;
     return LS_FALLBACK;
   }
-  precise float t = dot_in_order(p0 - origin, n) / denom;
-  if (!(t >= tmin)) {
+  if (found == LS_PLANE_BEHIND) {
     ls_counters.refused_behind += 1u;
     return LS_FALLBACK;
   }
-  if (!(t <= hit.t)) {
+  if (found == LS_PLANE_BEYOND) {
     ls_counters.refused_beyond += 1u;
     return LS_FALLBACK;
   }
-  // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
-  precise vec3 q = origin + dir * t - p0;
-  precise float nn = dot_in_order(n, n);
-  vec3 qs = scale_pow2(q, ke);
-  precise float b1 = dot_in_order(cross(qs, e2s), n) / nn;
-  precise float b2 = dot_in_order(cross(e1s, qs), n) / nn;
-  precise float b0 = 1.0f - b1 - b2;
-  uvec4 packed = tri_normals[prim];
-  precise vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
-  precise float c = dot_in_order(dir, ne);
-  precise float ne2 = dot_in_order(ne, ne);
-  precise float lhs = c * c;
-  precise float rhs = ls_cos2 * dot_in_order(dir, dir) * ne2;
-  if (ne2 == 0.0f || lhs < rhs) {
+  if (found == LS_PLANE_ANGLE) {
     ls_counters.refused_angle += 1u;
     return LS_FALLBACK;
   }
   uint inst = instance == LS_INVALID ? tri_instances[prim] : instance;
-  if (offer_hit(t, b1, b2, inst, tri_ids[prim], hit)) hit_prim = prim;
+  if (offer_hit(t, u, v, inst, tri_ids[prim], hit)) hit_prim = prim;
   ls_counters.accepted += 1u;
   return LS_ACCEPTED;
 }

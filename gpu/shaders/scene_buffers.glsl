@@ -26,7 +26,7 @@ layout(push_constant) uniform Params {
   uint any_hit;          // trace: stop at the first hit
   uint first;            // trace: first ray of this dispatch
   uint count;            // trace: rays in the buffer
-  float inv_n;           // unused: every LsNode carries its own 1 / N
+  uint ls_reverse;       // trace: --ls-behind reverse (ls_lookup.h)
   uint further_rays;     // candidates: search rays after the midpoint ray
   uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
   uint first_ls;         // candidates: first LS node of this dispatch
@@ -35,6 +35,7 @@ layout(push_constant) uniform Params {
 
 uint ls_enabled = pc.ls_enabled;
 float ls_cos2 = pc.ls_cos2;
+uint ls_reverse = pc.ls_reverse;
 LsCounters ls_counters;
 void count_work(uint node, uint boxes, uint triangles) {}  // the CPU's work counters (traverse_bvh.h)
 
