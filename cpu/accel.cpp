@@ -271,10 +271,10 @@ namespace {
 // trace_rays and trace_occlusion: TBB over chunks of rays, each chunk on its own copy of the trace
 // context, counters per thread and summed once.
 void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit, bool occlusion,
-                  lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
+                  lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work,
+                  const std::vector<uint8_t>* ls_subtrees) {
   lsk::TraceContext context = accel.context();
-  const std::vector<uint8_t> in_ls = work ? line_space_subtrees(accel) : std::vector<uint8_t>();
-  if (!in_ls.empty()) context.node_in_ls = in_ls.data();
+  if (work && ls_subtrees && !ls_subtrees->empty()) context.node_in_ls = ls_subtrees->data();
   const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
   // Per-thread counters, summed once at the end: no lock on the hot path.
   tbb::enumerable_thread_specific<lsk::LsCounters> per_thread(lsk::LsCounters{});
@@ -312,13 +312,14 @@ void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size
 }  // namespace
 
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
-                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work) {
-  trace_chunks(accel, rays, hits, count, any_hit, false, counters, traversal, work);
+                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work,
+                const std::vector<uint8_t>* ls_subtrees) {
+  trace_chunks(accel, rays, hits, count, any_hit, false, counters, traversal, work, ls_subtrees);
 }
 
 void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
                      Traversal traversal) {
-  trace_chunks(accel, rays, hits, count, true, true, counters, traversal, nullptr);
+  trace_chunks(accel, rays, hits, count, true, true, counters, traversal, nullptr, nullptr);
 }
 
 void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters) {

@@ -107,8 +107,11 @@ inline double work_units(uint64_t box_tests, uint64_t triangle_tests, uint64_t l
 // Per node of accel.nodes: 1 in the subtree of a node with a Line Space (that node included), else
 // 0.  Empty for a structure without a Line Space.
 std::vector<uint8_t> line_space_subtrees(const Accel& accel);
+// ls_subtrees (line_space_subtrees of accel): the work done in those subtrees is also counted as
+// work->*_in_ls; without it they stay 0.
 void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
-                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work = nullptr);
+                lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work = nullptr,
+                const std::vector<uint8_t>* ls_subtrees = nullptr);
 
 // Occlusion queries (shadow rays) on all threads: a ray misses exactly where trace_rays' any hit
 // misses; where it is blocked its hit record is *a* hit in [tmin, tmax] (on the fast path not

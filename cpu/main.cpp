@@ -77,7 +77,9 @@ class CpuBackend : public Backend {
     std::vector<lsk::Hit> hits(rays.size());
     TraceWorkTotals work;
     const bool reference = accel.traversal == Traversal::Reference;
-    trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, counters, accel.traversal, reference ? &work : nullptr);
+    const std::vector<uint8_t> ls_subtrees = reference ? line_space_subtrees(accel) : std::vector<uint8_t>();
+    trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, counters, accel.traversal, reference ? &work : nullptr,
+               &ls_subtrees);
     if (reference && note) {
       *note = "; reference work: " + std::to_string(work.box_tests) + " box tests, " + std::to_string(work.triangle_tests) +
               " triangle tests, " + std::to_string(work.lookups) + " lookups";

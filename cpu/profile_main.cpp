@@ -26,7 +26,7 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
-               "--occlusion] [--ls-min-triangles M] [--embree-isa ISA] [--exact-width 4|8]\n");
+               "--occlusion] [--ls-min-triangles M] [--ls-behind exact|reverse] [--embree-isa ISA] [--exact-width 4|8]\n");
   return 2;
 }
 
@@ -48,6 +48,8 @@ int main(int argc, char** argv) try {
     else if (a == "--occlusion") query = Query::Occlusion;
     else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
     else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
+    else if (a == "--ls-behind" && i + 1 < argc && (std::string(argv[i + 1]) == "exact" || std::string(argv[i + 1]) == "reverse"))
+      options.ls.reverse_behind = std::string(argv[++i]) == "reverse";
     else if (a == "--exact-width" && i + 1 < argc) options.exact_width = std::atoi(argv[++i]);  // 4 or 8, else InputError
     else return usage();
   }

@@ -404,7 +404,7 @@ TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, an
                     trace_all(build_accel(scene, parse_structure("bvh"), paper()), rays)));
 }
 
-TEST_CASE("--ls-behind reverse: from inside the box the reverse shaft's candidate answers, or says nothing is ahead", "[line_space]") {
+TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the reverse shaft's candidate answers, or says nothing is ahead", "[line_space]") {
   // Two parallel planes z = 0 and z = 1 and a wall at x = -0.9 that makes the box reach z = -1 .. 2,
   // so that neither plane lies on a face of the Line Space box.
   Mesh m;
@@ -468,7 +468,7 @@ TEST_CASE("--ls-behind reverse: from inside the box the reverse shaft's candidat
   }
 }
 
-TEST_CASE("--ls-behind reverse decides as documented, on a hand-made Line Space", "[line_space]") {
+TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as documented, on a hand-made Line Space", "[line_space]") {
   // One LS box [-1, 1]^2 x [-1, 2], N = 4.  Shafts starting on the -Z face hold the plane z = 0 (L),
   // those starting on +Z the triangle U under test, every other shaft is empty.  The rays start just
   // above L, so their shaft's candidate L lies behind them and the reverse shaft's is U (or empty).

@@ -11,7 +11,8 @@ namespace {
 TraceWorkTotals traced_work(const Accel& accel, const std::vector<lsk::Ray>& rays, lsk::LsCounters& counters) {
   std::vector<lsk::Hit> hits(rays.size());
   TraceWorkTotals work;
-  trace_rays(accel, rays.data(), hits.data(), rays.size(), false, &counters, Traversal::Reference, &work);
+  const std::vector<uint8_t> ls_subtrees = line_space_subtrees(accel);
+  trace_rays(accel, rays.data(), hits.data(), rays.size(), false, &counters, Traversal::Reference, &work, &ls_subtrees);
   return work;
 }
 
