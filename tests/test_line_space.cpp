@@ -93,6 +93,30 @@ bool same_bits(const std::vector<lsk::Hit>& a, const std::vector<lsk::Hit>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0;
 }
 
+// Rays from inside the unit cube (where random_soup lies, so inside its LS boxes) with intervals
+// [tmin, tmax] of random start and length.
+std::vector<lsk::Ray> interval_rays() {
+  std::mt19937 rng(23);
+  std::vector<lsk::Ray> rays = random_rays(20000, 29, glm::vec3(0.0f), glm::vec3(1.0f));
+  for (lsk::Ray& r : rays) {
+    r.tmin = 0.05f * uniform(rng);
+    r.tmax = r.tmin + 0.5f * uniform(rng);
+  }
+  return rays;
+}
+
+// Every reported hit lies in its ray's [tmin, tmax]; returns how many were reported.
+size_t require_in_interval(const std::vector<lsk::Hit>& hits, const std::vector<lsk::Ray>& rays) {
+  size_t count = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (hits[i].triangle == lsk::LS_INVALID) continue;
+    ++count;
+    REQUIRE(hits[i].t >= rays[i].tmin);
+    REQUIRE(hits[i].t <= rays[i].tmax);
+  }
+  return count;
+}
+
 // The paper's behaviour: every node at depth D gets a Line Space, however small its subtree.
 AccelOptions paper() {
   AccelOptions o;
@@ -342,12 +366,7 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
 TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes included", "[line_space]") {
   // Origins inside the soup's LS boxes: a candidate behind the origin must be refused, never reported.
   const Scene scene = single_mesh_scene(random_soup(3000, 17));
-  std::mt19937 rng(23);
-  std::vector<lsk::Ray> rays = random_rays(20000, 29, glm::vec3(0.0f), glm::vec3(1.0f));
-  for (lsk::Ray& r : rays) {
-    r.tmin = 0.05f * uniform(rng);
-    r.tmax = r.tmin + 0.5f * uniform(rng);
-  }
+  const std::vector<lsk::Ray> rays = interval_rays();
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
     const Accel a = build_accel(scene, parse_structure(name), angle(89.0f));
     lsk::LsCounters counters{};
@@ -356,29 +375,14 @@ TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes inc
     CHECK(counters.refused_behind > 0);
     CHECK(counters.refused_beyond > 0);
     CHECK(counters.accepted > 0);
-    size_t hit_count = 0;
-    for (size_t i = 0; i < rays.size(); ++i) {
-      if (hits[i].triangle == lsk::LS_INVALID) continue;
-      ++hit_count;
-      REQUIRE(hits[i].t >= rays[i].tmin);
-      REQUIRE(hits[i].t <= rays[i].tmax);
-    }
-    CHECK(hit_count > 0);
-    // Any-hit answers stay inside the interval too.
-    const std::vector<lsk::Hit> any = trace_all(a, rays, true);
-    for (size_t i = 0; i < rays.size(); ++i)
-      if (any[i].triangle != lsk::LS_INVALID) REQUIRE((any[i].t >= rays[i].tmin && any[i].t <= rays[i].tmax));
+    CHECK(require_in_interval(hits, rays) > 0);
+    require_in_interval(trace_all(a, rays, true), rays);  // any-hit answers stay inside the interval too
   }
 }
 
 TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, and nothing is refused as behind", "[line_space]") {
   const Scene scene = single_mesh_scene(random_soup(3000, 17));
-  std::mt19937 rng(23);
-  std::vector<lsk::Ray> rays = random_rays(20000, 29, glm::vec3(0.0f), glm::vec3(1.0f));
-  for (lsk::Ray& r : rays) {
-    r.tmin = 0.05f * uniform(rng);
-    r.tmax = r.tmin + 0.5f * uniform(rng);
-  }
+  const std::vector<lsk::Ray> rays = interval_rays();
   AccelOptions reverse = angle(89.0f);
   reverse.ls.reverse_behind = true;
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
@@ -391,11 +395,8 @@ TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, an
     CHECK(reverse_counters.refused_behind == 0);
     // The behind refusals became answers: more accepted or empty, the same lookups before them.
     CHECK(reverse_counters.accepted + reverse_counters.empty > exact_counters.accepted + exact_counters.empty);
-    for (size_t i = 0; i < rays.size(); ++i)
-      if (hits[i].triangle != lsk::LS_INVALID) REQUIRE((hits[i].t >= rays[i].tmin && hits[i].t <= rays[i].tmax));
-    const std::vector<lsk::Hit> any = trace_all(a, rays, true);
-    for (size_t i = 0; i < rays.size(); ++i)
-      if (any[i].triangle != lsk::LS_INVALID) REQUIRE((any[i].t >= rays[i].tmin && any[i].t <= rays[i].tmax));
+    CHECK(require_in_interval(hits, rays) > 0);
+    require_in_interval(trace_all(a, rays, true), rays);
   }
   // A refusal angle of 0 still refuses everything: the exact structure's hits.
   AccelOptions none = angle(0.0f);
