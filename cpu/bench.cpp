@@ -40,10 +40,9 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   // runs: each structure, then Embree, is refused over what the ones before it left of the budget
   // (memory_budget.h), so that together they stay within it.
   const size_t budget = memory_budget(options.ls.max_memory);
-  size_t held = rays.size() * (sizeof(lsk::Ray) + sizeof(lsk::Hit));  // then the structures built so far, fast paths included
-  if (held > budget)
-    throw InputError("bench's " + std::to_string(rays.size()) + " rays and their hits take " + mib_text(double(held)) +
-                     ", over the budget of " + mib_budget_text(double(budget)) + ": use fewer rays (--count) or raise --max-memory");
+  size_t held = ray_bytes(rays.size(), false, 1);  // then the structures built so far, fast paths included
+  check_held_budget("bench's " + std::to_string(rays.size()) + " rays and their hits", held, options.ls.max_memory,
+                    "use fewer rays (--count) or raise --max-memory");
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) {
     const std::string held_by = "bench holds its rays, hits and structures at once, and the rays, hits and structures before '" +

@@ -90,6 +90,8 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.rays->add_option("--count", v.count)->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 28));
   c.rays->add_option("--seed", v.seed)->capture_default_str();
   c.rays->add_option("--out", v.out_path, "ray file to write")->required();
+  c.rays->add_option("--max-memory", v.ls.max_memory_mb, "refuse a ray count estimated above this many MB (0: half of RAM)")
+      ->check(CLI::Range(0.0, 1e9));
 
   c.render = app.add_subcommand("render", "path trace; write EXRs per bounce, a PNG and report.json");
   common(c.render, true);
@@ -232,6 +234,25 @@ void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v)
   throw InputError("--ls-budget applies to 2l-ls:auto only, and no structure here is 2l-ls:auto");
 }
 
+// The rays a command holds, refused over the budget before the scene is loaded or a ray made.
+void check_ray_budgets(const Commands& c, const Values& v) {
+  const size_t max_memory = v.ls.options().ls.max_memory;
+  if (*c.rays)
+    check_held_budget("rays: " + std::to_string(v.count) + " rays", ray_bytes(v.count, true, 0), max_memory,
+                      "make fewer (--count) or raise --max-memory");
+  if (*c.trace) {
+    const size_t count = ray_file_count(v.rays_path);
+    check_held_budget("trace's " + std::to_string(count) + " rays and their hits", ray_bytes(count, false, 1), max_memory,
+                      "trace a smaller ray file or raise --max-memory");
+  }
+  if (*c.bench) {
+    const bool made = v.rays_path.empty();
+    const size_t count = made ? v.count : ray_file_count(v.rays_path);
+    check_held_budget("bench's " + std::to_string(count) + " rays and their hits", ray_bytes(count, made, 1), max_memory,
+                      made ? "use fewer rays (--count) or raise --max-memory" : "bench a smaller ray file or raise --max-memory");
+  }
+}
+
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   const ThreadLimit threads(v.threads.threads);  // first: a bad count is refused before any work
   if (*c.build || *c.trace) check_budget_flag({parse_structure(v.structure)}, v);
@@ -247,6 +268,7 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
                 v.out_dir.c_str());
     return;
   }
+  check_ray_budgets(c, v);
   const Scene scene = load_scene(v.scene);
   if (*c.rays) {  // host work only: no backend (no device) needed
     write_rays(v.out_path, make_rays(scene, v.kind, v.count, v.seed));

@@ -164,6 +164,19 @@ void check_fast_path_budget(const Accel& accel, int width, int exact_width, size
                    mib_budget_text(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
 }
 
+size_t ray_bytes(size_t count, bool made, int hits) {
+  const size_t held = sizeof(lsk::Ray) + size_t(hits) * sizeof(lsk::Hit);
+  const size_t making = 2 * sizeof(lsk::Ray) + 1;
+  return count * (made ? std::max(held, making) : held);
+}
+
+void check_held_budget(const std::string& what, size_t bytes, size_t max_memory, const std::string& remedy) {
+  const size_t budget = memory_budget(max_memory);
+  if (bytes <= budget) return;
+  throw InputError(what + " take up to " + mib_text(double(bytes)) + ", over the budget of " + mib_budget_text(double(budget)) +
+                   ": " + remedy);
+}
+
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces) {
   // Per pixel: bounce images and the total (12 B each), path state, hit, batch ray and hit, shadow
   // query, flags and counters (~170 B), the PNG's 3 bytes and one EXR conversion copy (12 B).

@@ -52,6 +52,16 @@ size_t fast_path_bytes_at_most(const Accel& accel, int width, int exact_width);
 // memory_budget(max_memory).
 void check_fast_path_budget(const Accel& accel, int width, int exact_width, size_t max_memory);
 
+// Bytes a command holds for `count` rays: the rays and `hits` hits a ray, and where the rays are
+// made here (made), at least the generator's peak: the rays and one round of candidates with their
+// flags (ray_generators.cpp).
+size_t ray_bytes(size_t count, bool made, int hits);
+
+// Throws InputError when `bytes` (what `what` names, e.g. "bench's 200000 rays and their hits")
+// exceed memory_budget(max_memory); `remedy` says what to change.  Called before the rays are made
+// or read, so a refusal never waits for them.
+void check_held_budget(const std::string& what, size_t bytes, size_t max_memory, const std::string& remedy);
+
 // Bytes of the render's image and per-pixel buffers: (bounces + 2) images of 12 B per pixel, the
 // wavefront state (~170 B per pixel) and the 8-bit PNG, for width x height pixels.
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces);

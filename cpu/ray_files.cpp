@@ -61,6 +61,13 @@ std::vector<lsk::Ray> read_rays(const std::string& path) {
   return rays;
 }
 
+size_t ray_file_count(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return 0;
+  const auto size = std::filesystem::file_size(path, ec);
+  return ec ? 0 : size_t(size / sizeof(lsk::Ray));
+}
+
 void write_rays(const std::string& path, const std::vector<lsk::Ray>& rays) { write_records(path, rays, "ray"); }
 std::vector<lsk::Hit> read_hits(const std::string& path) { return read_records<lsk::Hit>(path, "hit"); }
 void write_hits(const std::string& path, const std::vector<lsk::Hit>& hits) { write_records(path, hits, "hit"); }

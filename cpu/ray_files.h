@@ -6,6 +6,7 @@
 
 #include "kernels/layouts.h"
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,9 @@ namespace ls {
 // Throws InputError: missing file, size not a multiple of 32, NaN/Inf origins or directions, a zero
 // direction, NaN bounds or tmin > tmax (each names the first bad record).
 std::vector<lsk::Ray> read_rays(const std::string& path);
+// The rays a ray file holds, from its size (0 where it is no regular file: read_rays says why), so that
+// a memory budget can be checked before it is read.
+size_t ray_file_count(const std::string& path);
 void write_rays(const std::string& path, const std::vector<lsk::Ray>& rays);
 std::vector<lsk::Hit> read_hits(const std::string& path);
 void write_hits(const std::string& path, const std::vector<lsk::Hit>& hits);

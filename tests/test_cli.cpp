@@ -220,6 +220,39 @@ TEST_CASE("bench counts its rays, hits and Embree's scene in --max-memory", "[cl
   CHECK(rays.err.find("--count") != std::string::npos);
 }
 
+TEST_CASE("rays, trace and bench refuse rays over --max-memory before loading or making anything", "[cli]") {
+  const fs::path rays = temp("budget.rays");
+  REQUIRE(run("rays --scene builtin:cornell --count 1000 --seed 5 --out " + rays.string()).status == 0);
+  // Made here: up to 65 B a ray (the rays and a round of candidates), 65 MB for a million; a file's
+  // 1,000 rays and their hits: 52 kB, over 0.05 MB.
+  const std::array<std::tuple<std::string, std::string, std::string>, 4> cases = {{
+      {"rays --scene builtin:cornell --count 1000000 --max-memory 10 --out " + temp("many.rays").string(), "1000000 rays take up to 62 MiB",
+       "make fewer (--count)"},
+      {"trace --scene builtin:cornell --structure bvh --max-memory 0.05 --rays " + rays.string() + " --hits " + temp("h.hits").string(),
+       "trace's 1000 rays and their hits", "trace a smaller ray file"},
+      {"bench --scene builtin:cornell --structures bvh --max-memory 0.05 --rays " + rays.string(), "bench's 1000 rays and their hits",
+       "bench a smaller ray file"},
+      {"bench --scene builtin:cornell --structures bvh --max-memory 10 --count 1000000", "bench's 1000000 rays and their hits",
+       "use fewer rays (--count)"},
+  }};
+  for (const auto& [args, what, advice] : cases) {
+    const Run r = run(args);
+    INFO(args << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find(what) != std::string::npos);
+    CHECK(r.err.find(advice) != std::string::npos);
+    CHECK(r.err.find("--max-memory") != std::string::npos);
+    CHECK(r.out.empty());
+  }
+  CHECK(!fs::exists(temp("many.rays")));
+  CHECK(!fs::exists(temp("h.hits")));
+  // Within the budget the same commands run.
+  CHECK(run("rays --scene builtin:cornell --count 1000 --max-memory 1 --out " + temp("few.rays").string()).status == 0);
+  CHECK(run("trace --scene builtin:cornell --structure bvh --max-memory 20 --rays " + rays.string() + " --hits " +
+            temp("h.hits").string()).status == 0);
+}
+
 TEST_CASE("the flag --threads limits a run's threads and its reports name the count", "[cli]") {
   const int cpus = tbb::info::default_concurrency();
   for (int threads : {1, 0}) {

@@ -146,3 +146,15 @@ TEST_CASE("amounts are named rounded up and budgets rounded down, so an amount o
       CHECK(number(mib_text(amount)) > number(mib_budget_text(budget)));
     }
 }
+
+TEST_CASE("rays held over the budget are refused, at the budget they are not", "[budget]") {
+  // Held: the rays and their hits; made here, at least the generator's two ray arrays and flags.
+  CHECK(ray_bytes(1000, false, 1) == 1000 * (sizeof(lsk::Ray) + sizeof(lsk::Hit)));
+  CHECK(ray_bytes(1000, false, 0) == 1000 * sizeof(lsk::Ray));
+  CHECK(ray_bytes(1000, true, 0) == 1000 * (2 * sizeof(lsk::Ray) + 1));
+  CHECK(ray_bytes(1000, true, 1) == 1000 * (2 * sizeof(lsk::Ray) + 1));
+  CHECK(ray_bytes(1000, true, 2) == 1000 * (sizeof(lsk::Ray) + 2 * sizeof(lsk::Hit)));
+  CHECK_NOTHROW(check_held_budget("test's rays", 1000000, 1000000, "fewer"));
+  CHECK_THROWS_WITH(check_held_budget("test's rays", 1000001, 1000000, "use fewer"),
+                    Contains("test's rays take up to 1 MiB, over the budget of 0.9 MiB: use fewer"));
+}

@@ -63,6 +63,25 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
   REQUIRE(validate("").status == 2);
 }
 
+TEST_CASE("linespace-validate bound and hits refuse rays over --max-memory before building anything", "[cli]") {
+  // 200,000 rays made here: up to 65 B a ray for bound (the generator's peak), 72 B for hits (the
+  // rays and two hit arrays): 13 and 14.4 MB, over 8 MB.  Refused before a Vulkan device is asked.
+  const std::array<std::pair<std::string, std::string>, 2> cases = {{
+      {"bound --scene builtin:cornell --count 200000 --max-memory 8 --out " + temp("unused").string(),
+       "bound's 200000 rays and their hits take up to 13 MiB"},
+      {"hits --scene builtin:cornell --count 200000 --max-memory 8", "hits: 200000 rays and their CPU and GPU hits take up to 14 MiB"},
+  }};
+  for (const auto& [args, what] : cases) {
+    const Run r = validate(args);
+    INFO(args << "\nstderr: " << r.err);
+    REQUIRE(r.status == 2);
+    REQUIRE(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    REQUIRE(r.err.find(what) != std::string::npos);
+    REQUIRE(r.err.find("use fewer rays (--count) or raise --max-memory") != std::string::npos);
+  }
+  REQUIRE_FALSE(fs::exists(temp("unused") / "bound.json"));
+}
+
 TEST_CASE("linespace-validate rmse writes rmse.json with the documented keys and heat-maps", "[cli]") {
   const fs::path out = temp("rmse");
   const Run r = validate("rmse --scene builtin:generated:2000:4:1 --structures f-ls:4:4,2l-ls:0:4 --size 16x16 "

@@ -4,6 +4,7 @@
 #include "gpu_line_space.h"
 #include "gpu_trace.h"
 #include "load_scene.h"
+#include "memory_budget.h"
 #include "ray_files.h"
 #include "ray_generators.h"
 
@@ -157,6 +158,11 @@ int run_candidates_command(const CrossCheckCommand& command, const AccelOptions&
 }
 
 int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options) {
+  // On the host: the rays, the CPU's hits and the GPU's hits read back.
+  const size_t count = command.rays.empty() ? command.count : ray_file_count(command.rays);
+  check_held_budget("hits: " + std::to_string(count) + " rays and their CPU and GPU hits", ray_bytes(count, command.rays.empty(), 2),
+                    options.ls.max_memory,
+                    command.rays.empty() ? "use fewer rays (--count) or raise --max-memory" : "use a smaller ray file or raise --max-memory");
   const Scene scene = command_scene(command);
   const StructureSpec spec = parse_structure(command.structure);
   std::vector<lsk::Ray> rays;

@@ -6,6 +6,7 @@
 #include "cli_flags.h"
 #include "cross_check.h"
 #include "load_scene.h"
+#include "memory_budget.h"
 #include "paper_tables.h"
 #include "policy_study.h"
 #include "ray_files.h"
@@ -268,6 +269,10 @@ int main(int argc, char** argv) {
       const std::vector<StructureSpec> specs = parse_structure_list(bound_structures);
       AccelOptions accel_options = ls_flags.options();
       accel_options.fast_path = false;
+      const size_t count = bound_rays.empty() ? bound_count : ray_file_count(bound_rays);
+      check_held_budget("bound's " + std::to_string(count) + " rays and their hits", ray_bytes(count, bound_rays.empty(), 1),
+                        accel_options.ls.max_memory,
+                        bound_rays.empty() ? "use fewer rays (--count) or raise --max-memory" : "use a smaller ray file or raise --max-memory");
       const Scene scene = load_scene(scene_spec);
       std::vector<lsk::Ray> rays;
       std::string rays_name = bound_rays;
