@@ -41,7 +41,7 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   // (memory_budget.h), so that together they stay within it.
   const size_t budget = memory_budget(options.ls.max_memory);
   size_t held = ray_bytes(rays.size(), false, 1);  // then the structures built so far, fast paths included
-  check_held_budget("bench's " + std::to_string(rays.size()) + " rays and their hits", held, options.ls.max_memory,
+  check_held_budget("bench: " + std::to_string(rays.size()) + " rays and their hits", held, options.ls.max_memory,
                     "use fewer rays (--count) or raise --max-memory");
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) {

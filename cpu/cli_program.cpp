@@ -237,20 +237,9 @@ void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v)
 // The rays a command holds, refused over the budget before the scene is loaded or a ray made.
 void check_ray_budgets(const Commands& c, const Values& v) {
   const size_t max_memory = v.ls.options().ls.max_memory;
-  if (*c.rays)
-    check_held_budget("rays: " + std::to_string(v.count) + " rays", ray_bytes(v.count, true, 0), max_memory,
-                      "make fewer (--count) or raise --max-memory");
-  if (*c.trace) {
-    const size_t count = ray_file_count(v.rays_path);
-    check_held_budget("trace's " + std::to_string(count) + " rays and their hits", ray_bytes(count, false, 1), max_memory,
-                      "trace a smaller ray file or raise --max-memory");
-  }
-  if (*c.bench) {
-    const bool made = v.rays_path.empty();
-    const size_t count = made ? v.count : ray_file_count(v.rays_path);
-    check_held_budget("bench's " + std::to_string(count) + " rays and their hits", ray_bytes(count, made, 1), max_memory,
-                      made ? "use fewer rays (--count) or raise --max-memory" : "bench a smaller ray file or raise --max-memory");
-  }
+  if (*c.rays) check_ray_budget("rays", "", v.count, 0, max_memory);
+  if (*c.trace) check_ray_budget("trace", v.rays_path, 0, 1, max_memory);
+  if (*c.bench) check_ray_budget("bench", v.rays_path, v.count, 1, max_memory);
 }
 
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {

@@ -4,6 +4,7 @@
 #include "exact_wide_bvh.h"
 #include "kernels/layouts.h"
 #include "kernels/line_space.h"
+#include "ray_files.h"
 #include "triangle_blocks.h"
 #include "wide_bvh.h"
 
@@ -175,6 +176,14 @@ void check_held_budget(const std::string& what, size_t bytes, size_t max_memory,
   if (bytes <= budget) return;
   throw InputError(what + " take up to " + mib_text(double(bytes)) + ", over the budget of " + mib_budget_text(double(budget)) +
                    ": " + remedy);
+}
+
+void check_ray_budget(const std::string& command, const std::string& rays_path, size_t count, int hits, size_t max_memory) {
+  const bool made = rays_path.empty();
+  if (!made) count = ray_file_count(rays_path);
+  check_held_budget(command + ": " + std::to_string(count) + " rays" + (hits > 0 ? " and their hits" : ""),
+                    ray_bytes(count, made, hits), max_memory,
+                    made ? "use fewer rays (--count) or raise --max-memory" : "use a smaller ray file or raise --max-memory");
 }
 
 size_t estimate_render_bytes(uint32_t width, uint32_t height, int bounces) {

@@ -57,10 +57,14 @@ void check_fast_path_budget(const Accel& accel, int width, int exact_width, size
 // flags (ray_generators.cpp).
 size_t ray_bytes(size_t count, bool made, int hits);
 
-// Throws InputError when `bytes` (what `what` names, e.g. "bench's 200000 rays and their hits")
-// exceed memory_budget(max_memory); `remedy` says what to change.  Called before the rays are made
-// or read, so a refusal never waits for them.
+// Throws InputError when `bytes` (what `what` names, e.g. "bench: 200000 rays and their hits")
+// exceed memory_budget(max_memory); `remedy` says what to change.
 void check_held_budget(const std::string& what, size_t bytes, size_t max_memory, const std::string& remedy);
+
+// check_held_budget for a command's rays, before they are made or read: `count` rays made here where
+// rays_path is empty, else the ray file's, each with `hits` hits kept ("bench: 1000 rays and their
+// hits take up to 0.1 MiB, over the budget of ...: use a smaller ray file or raise --max-memory").
+void check_ray_budget(const std::string& command, const std::string& rays_path, size_t count, int hits, size_t max_memory);
 
 // Bytes of the render's image and per-pixel buffers: (bounces + 2) images of 12 B per pixel, the
 // wavefront state (~170 B per pixel) and the 8-bit PNG, for width x height pixels.

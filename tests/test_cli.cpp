@@ -226,13 +226,13 @@ TEST_CASE("rays, trace and bench refuse rays over --max-memory before loading or
   // Made here: up to 65 B a ray (the rays and a round of candidates), 65 MB for a million; a file's
   // 1,000 rays and their hits: 52 kB, over 0.05 MB.
   const std::array<std::tuple<std::string, std::string, std::string>, 4> cases = {{
-      {"rays --scene builtin:cornell --count 1000000 --max-memory 10 --out " + temp("many.rays").string(), "1000000 rays take up to 62 MiB",
-       "make fewer (--count)"},
+      {"rays --scene builtin:cornell --count 1000000 --max-memory 10 --out " + temp("many.rays").string(), "rays: 1000000 rays take up to 62 MiB",
+       "use fewer rays (--count)"},
       {"trace --scene builtin:cornell --structure bvh --max-memory 0.05 --rays " + rays.string() + " --hits " + temp("h.hits").string(),
-       "trace's 1000 rays and their hits", "trace a smaller ray file"},
-      {"bench --scene builtin:cornell --structures bvh --max-memory 0.05 --rays " + rays.string(), "bench's 1000 rays and their hits",
-       "bench a smaller ray file"},
-      {"bench --scene builtin:cornell --structures bvh --max-memory 10 --count 1000000", "bench's 1000000 rays and their hits",
+       "trace: 1000 rays and their hits", "use a smaller ray file"},
+      {"bench --scene builtin:cornell --structures bvh --max-memory 0.05 --rays " + rays.string(), "bench: 1000 rays and their hits",
+       "use a smaller ray file"},
+      {"bench --scene builtin:cornell --structures bvh --max-memory 10 --count 1000000", "bench: 1000000 rays and their hits",
        "use fewer rays (--count)"},
   }};
   for (const auto& [args, what, advice] : cases) {

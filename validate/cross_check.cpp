@@ -158,11 +158,7 @@ int run_candidates_command(const CrossCheckCommand& command, const AccelOptions&
 }
 
 int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options) {
-  // On the host: the rays, the CPU's hits and the GPU's hits read back.
-  const size_t count = command.rays.empty() ? command.count : ray_file_count(command.rays);
-  check_held_budget("hits: " + std::to_string(count) + " rays and their CPU and GPU hits", ray_bytes(count, command.rays.empty(), 2),
-                    options.ls.max_memory,
-                    command.rays.empty() ? "use fewer rays (--count) or raise --max-memory" : "use a smaller ray file or raise --max-memory");
+  check_ray_budget("hits", command.rays, command.count, 2, options.ls.max_memory);  // the CPU's hits and the GPU's
   const Scene scene = command_scene(command);
   const StructureSpec spec = parse_structure(command.structure);
   std::vector<lsk::Ray> rays;

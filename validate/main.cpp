@@ -269,10 +269,7 @@ int main(int argc, char** argv) {
       const std::vector<StructureSpec> specs = parse_structure_list(bound_structures);
       AccelOptions accel_options = ls_flags.options();
       accel_options.fast_path = false;
-      const size_t count = bound_rays.empty() ? bound_count : ray_file_count(bound_rays);
-      check_held_budget("bound's " + std::to_string(count) + " rays and their hits", ray_bytes(count, bound_rays.empty(), 1),
-                        accel_options.ls.max_memory,
-                        bound_rays.empty() ? "use fewer rays (--count) or raise --max-memory" : "use a smaller ray file or raise --max-memory");
+      check_ray_budget("bound", bound_rays, bound_count, 1, accel_options.ls.max_memory);
       const Scene scene = load_scene(scene_spec);
       std::vector<lsk::Ray> rays;
       std::string rays_name = bound_rays;
