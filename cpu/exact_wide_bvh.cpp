@@ -15,6 +15,7 @@ template <int kWidth>
 struct Collapser {
   const std::vector<lsk::BvhNode>& nodes;
   const std::vector<uint32_t>& node_ls;
+  const ExactLeaves leaves;
   ExactWideTree<kWidth>& tree;
 
   bool inner(uint32_t b) const { return nodes[b].count == 0; }
@@ -31,48 +32,71 @@ struct Collapser {
     return Range{std::min(l.first, r.first), l.count + r.count};
   }
   // A lane for b is a leaf: a binary leaf, or a subtree of at most kLeafMax primitives that the
-  // surface area heuristic prefers as one leaf (merge[b], see sah_cost).
+  // surface area heuristic prefers as one leaf (merge[b], see sah).
   std::vector<uint8_t> merge;
   bool leaf_lane(uint32_t b) const { return !inner(b) || merge[b] != 0; }
 
-  // The expected cost of a ray that reaches b's box, in box tests (SAH), with b's subtree made a
-  // leaf wherever that is cheaper, and the primitives below b.  Marks merge[b].
-  struct Sah {
-    float cost;
-    uint32_t count;
-  };
+  // The collapse of least expected cost, by the surface area heuristic (Ylitie, Karras and Laine,
+  // "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017, section
+  // 3.1): cost[i - 1] of b is the least cost of b's subtree given as at most i lanes of its wide
+  // parent, in half-area units with ExactWideTree's kNodeCost per wide node and kBlockCost per
+  // block.  One lane is b itself, as a leaf or as a wide node; more divide the lanes between b's
+  // two children.  split[b][i - 1], for i >= 2, is how many of those i the first child gets, 0
+  // where i - 1 lanes cost as little; split[b][0] is that division for b's own wide node, kWidth
+  // lanes.  Marks merge[b].  In doubles: the half areas of huge boxes overflow a float.
+  using Costs = std::array<double, kWidth>;
+  std::vector<std::array<uint8_t, kWidth>> split;
+
   // The top `parallel_levels` levels below b recurse as parallel tasks.
-  Sah sah(uint32_t b, int parallel_levels = 0) {
+  Costs sah(uint32_t b, int parallel_levels = 0) {
+    using Tree = ExactWideTree<kWidth>;
     const lsk::BvhNode& n = nodes[b];
+    const double area = half_area(n);
+    Costs cost;
+    split[b].fill(0);
     if (!inner(b)) {
       prims[b] = n.count;
-      return Sah{kBlockCost * float((n.count + 3u) / 4u), n.count};
+      cost.fill(area * Tree::leaf_cost(leaves, n.count));
+      return cost;
     }
-    Sah l;
-    Sah r;
+    Costs l;
+    Costs r;
     if (parallel_levels > 0)
       ls::parallel_invoke([&] { l = sah(n.first, parallel_levels - 1); }, [&] { r = sah(n.first + 1, parallel_levels - 1); });
     else {
       l = sah(n.first);
       r = sah(n.first + 1);
     }
-    const float area = half_area(n);
-    const float split = area > 0.0f
-                            ? 1.0f + (half_area(nodes[n.first]) * l.cost + half_area(nodes[n.first + 1]) * r.cost) / area
-                            : 1.0f + l.cost + r.cost;
-    const uint32_t count = l.count + r.count;
+    const uint32_t count = prims[n.first] + prims[n.first + 1];
     prims[b] = count;
-    if (count <= ExactWideTree<kWidth>::kLeafMax && kBlockCost <= split) {
-      merge[b] = 1;
-      return Sah{kBlockCost, count};
+    // j lanes divided between the children, k to the first: the cheapest k for each j.  k starts
+    // at 1, so a cost that is not finite still leaves a valid division.
+    std::array<double, kWidth + 1> divided;
+    std::array<uint8_t, kWidth + 1> divided_k;
+    for (int j = 2; j <= kWidth; ++j) {
+      divided[size_t(j)] = l[0] + r[size_t(j - 2)];
+      divided_k[size_t(j)] = 1;
+      for (int k = 2; k < j; ++k) {
+        const double c = l[size_t(k - 1)] + r[size_t(j - k - 1)];
+        if (c < divided[size_t(j)]) {
+          divided[size_t(j)] = c;
+          divided_k[size_t(j)] = uint8_t(k);
+        }
+      }
     }
-    return Sah{split, count};
+    const double as_node = area * Tree::kNodeCost + divided[kWidth];
+    const double as_leaf = count <= Tree::kLeafMax ? area * Tree::leaf_cost(leaves, count) : std::numeric_limits<double>::infinity();
+    merge[b] = as_leaf <= as_node;
+    cost[0] = merge[b] ? as_leaf : as_node;
+    split[b][0] = divided_k[kWidth];
+    for (int i = 2; i <= kWidth; ++i) {
+      const bool more = divided[size_t(i)] < cost[size_t(i - 2)];
+      cost[size_t(i - 1)] = more ? divided[size_t(i)] : cost[size_t(i - 2)];
+      split[b][size_t(i - 1)] = more ? divided_k[size_t(i)] : 0;
+    }
+    return cost;
   }
   std::vector<uint32_t> prims;  // per node below an entry: its primitives (sah)
-
-  // A block of four triangles costs about four box tests (the ratio of their instruction counts in
-  // the fast path, callgrind); a node's box test is the unit.
-  static constexpr float kBlockCost = 4.0f;
 
   std::vector<uint8_t> has_ls;  // per node: 1 when a Line Space node lies in its subtree (itself included)
 
@@ -98,35 +122,29 @@ struct Collapser {
     find_entries(l + 1, out);
   }
 
-  static float half_area(const lsk::BvhNode& n) {
-    const lsk::vec3 d = n.hi - n.lo;
-    return d.x * d.y + d.y * d.z + d.z * d.x;
+  static double half_area(const lsk::BvhNode& n) {
+    const double x = double(n.hi.x) - double(n.lo.x);
+    const double y = double(n.hi.y) - double(n.lo.y);
+    const double z = double(n.hi.z) - double(n.lo.z);
+    return x * y + y * z + z * x;
   }
 
-  // The children of the wide node for the inner node b: its two children, then, while fewer than
-  // kWidth, the inner child of largest surface area replaced by its two children.
+  // The lanes of the wide node for the inner node b, as sah chose them.
   int children(uint32_t b, std::array<uint32_t, kWidth>& lanes) const {
-    std::array<float, kWidth> area;  // an inner lane's half area, -1 for a leaf lane (never opened)
-    auto set = [&](int i, uint32_t node) {
-      lanes[size_t(i)] = node;
-      area[size_t(i)] = leaf_lane(node) ? -1.0f : half_area(nodes[node]);
+    int n = 0;
+    auto emit = [&](auto&& self, uint32_t x, int i) -> void {  // x as at most i lanes, as split says
+      while (i > 1 && split[x][size_t(i - 1)] == 0) --i;
+      if (i == 1) {
+        lanes[size_t(n++)] = x;
+        return;
+      }
+      const int k = split[x][size_t(i - 1)];
+      self(self, nodes[x].first, k);
+      self(self, nodes[x].first + 1, i - k);
     };
-    set(0, nodes[b].first);
-    set(1, nodes[b].first + 1);
-    int n = 2;
-    while (n < kWidth) {
-      int best = -1;
-      float best_area = -1.0f;
-      for (int i = 0; i < n; ++i)
-        if (area[size_t(i)] > best_area) {
-          best = i;
-          best_area = area[size_t(i)];
-        }
-      if (best < 0) break;
-      const uint32_t opened = lanes[size_t(best)];
-      set(best, nodes[opened].first);
-      set(n++, nodes[opened].first + 1);
-    }
+    const int k = split[b][0];
+    emit(emit, nodes[b].first, k);
+    emit(emit, nodes[b].first + 1, kWidth - k);
     return n;
   }
 
@@ -195,10 +213,10 @@ struct Collapser {
 
 template <int W>
 ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                                       const std::vector<uint32_t>& roots) {
+                                       const std::vector<uint32_t>& roots, ExactLeaves leaves) {
   ExactWideTree<W> tree;
   tree.entry_of.assign(nodes.size(), lsk::LS_INVALID);
-  Collapser<W> c{nodes, node_ls, tree, {}, {}, {}, {}};
+  Collapser<W> c{nodes, node_ls, leaves, tree, {}, {}, {}, {}, {}};
   std::vector<uint32_t> entries;
   if (!node_ls.empty()) {
     c.has_ls.assign(nodes.size(), 0);
@@ -208,6 +226,7 @@ ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, c
   for (uint32_t r : roots)
     if (r != lsk::LS_INVALID && r < nodes.size()) c.find_entries(r, entries);
   c.merge.assign(nodes.size(), 0);
+  c.split.resize(nodes.size());
   c.prims.resize(nodes.size());
   c.wide_nodes.resize(nodes.size());
   // Each entry once (two-level roots may share one), in order; entries are disjoint subtrees.
@@ -236,8 +255,8 @@ ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, c
 }
 
 template ExactWideTree<4> build_exact_wide_tree<4>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
-                                                   const std::vector<uint32_t>&);
+                                                   const std::vector<uint32_t>&, ExactLeaves);
 template ExactWideTree<8> build_exact_wide_tree<8>(const std::vector<lsk::BvhNode>&, const std::vector<uint32_t>&,
-                                                   const std::vector<uint32_t>&);
+                                                   const std::vector<uint32_t>&, ExactLeaves);
 
 }  // namespace ls

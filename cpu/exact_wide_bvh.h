@@ -12,9 +12,14 @@
 // Entries: the order-free walk starts at the *entry* nodes of a binary BVH, the topmost inner nodes
 // with no Line Space node strictly below them: the root of an exact structure, each Line Space node
 // (its subtree, when a lookup is refused), and the Line-Space-free subtrees between them.  Each entry
-// is collapsed on its own into wide nodes by opening, while fewer children than the width, the child
-// of largest surface area.  A subtree of at most kLeafMax primitives becomes one leaf: four triangles
-// cost one SIMD test whether they sit in one binary leaf or in three, and a level less is a load less.
+// is collapsed on its own into the wide tree of least expected cost by the surface area heuristic
+// (Ylitie, Karras and Laine 2017: a dynamic programme over the binary tree, which chooses for every
+// wide node which binary descendants become its lanes, and which subtrees of at most kLeafMax
+// primitives become one leaf: four triangles cost one SIMD test whether they sit in one binary leaf
+// or in three, and a level less is a load less).  It replaced a greedy collapse (open the child of
+// largest area while there is room), whose bottom levels were wide nodes of two or three leaves:
+// on builtin:generated:143000:49:1, 14,618 nodes, half of them with two lanes, against 8,732 now
+// (docs/performance.md).
 #pragma once
 
 #include "kernels/layouts.h"
@@ -24,6 +29,11 @@
 #include <vector>
 
 namespace ls {
+
+// What a tree's leaves hold, for the collapse's cost model: triangles, tested a block of four at a
+// time, or instances (a two-level top level), each entered on its own (its ray transformed, its
+// object's walk set up and begun).
+enum class ExactLeaves { Triangles, Instances };
 
 template <int W>
 struct alignas(64) ExactWideNode {
@@ -42,6 +52,18 @@ template <int W>
 struct ExactWideTree {
   using Node = ExactWideNode<W>;
   static constexpr uint32_t kLeafMax = 4;  // one triangle block
+  // The collapse's cost model: a wide node's box tests, a block of four triangles, and an instance
+  // entered, per ray that reaches their box.  The first two in the ratio of the fast path's
+  // instructions (callgrind): about 110 a wide node visited, 280 a block; bvh's traversal time
+  // hardly moved for block costs from 1.5 to 5, nor 2l-bvh's for instance costs from 1 to 16
+  // (docs/performance.md).
+  static constexpr double kNodeCost = 1.0;
+  static constexpr double kBlockCost = 2.5;
+  static constexpr double kInstanceCost = 4.0;
+  // The cost of a leaf of `count` primitives, per ray that reaches its box.
+  static double leaf_cost(ExactLeaves leaves, uint32_t count) {
+    return leaves == ExactLeaves::Triangles ? kBlockCost * double((count + 3u) / 4u) : kInstanceCost * double(count);
+  }
   std::vector<Node> nodes;
   std::vector<uint32_t> entry_of;  // per binary node: the wide node of the entry rooted there, or LS_INVALID
   size_t entries = 0;
@@ -52,6 +74,6 @@ struct ExactWideTree {
 // (no Line Space).
 template <int W>
 ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                                       const std::vector<uint32_t>& roots);
+                                       const std::vector<uint32_t>& roots, ExactLeaves leaves = ExactLeaves::Triangles);
 
 }  // namespace ls

@@ -474,7 +474,7 @@ class WideTracer final : public FastTracer {
   // The top level: the exact wide tree, whose leaf lanes hold their first instance, and for Line
   // Space structures the treelets.
   void build_top(const Accel& accel) {
-    top_exact_ = build_exact_wide_tree<W>(accel.top_nodes, {}, {0u});
+    top_exact_ = build_exact_wide_tree<W>(accel.top_nodes, {}, {0u}, ExactLeaves::Instances);
     if (ordered_) top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
   }
 

@@ -118,7 +118,6 @@ namespace {
 struct BvhShape {
   size_t nodes = 0;
   size_t inner = 0;
-  size_t leaves = 0;
   size_t blocks = 0;  // ceil(count / 4) summed over the leaves
 };
 
@@ -126,30 +125,28 @@ BvhShape bvh_shape(const std::vector<lsk::BvhNode>& nodes) {
   BvhShape s;
   s.nodes = nodes.size();
   for (const lsk::BvhNode& n : nodes)
-    if (n.count > 0) {
-      ++s.leaves;
+    if (n.count > 0)
       s.blocks += (size_t(n.count) + 3u) / 4u;
-    } else {
+    else
       ++s.inner;
-    }
   return s;
 }
 
 }  // namespace
 
 size_t fast_path_bytes_at_most(const Accel& accel, int width, int exact_width) {
-  const size_t w = size_t(exact_width);
   const size_t exact_node = exact_width == 8 ? sizeof(ExactWideNode<8>) : sizeof(ExactWideNode<4>);
   const size_t treelet_node = width == 8 ? sizeof(WideNode<3>) : sizeof(WideNode<2>);
   const bool treelets = accel.spec.line_space();
-  auto exact_nodes = [&](size_t leaves) { return (leaves * w + 2 * (w - 1) - 1) / (2 * (w - 1)); };  // rounded up
+  // Each order-free node is made from a distinct binary inner node (the collapse picks its lanes
+  // among that node's descendants).
   const BvhShape object = bvh_shape(accel.nodes);
-  size_t bytes = exact_nodes(object.leaves) * exact_node + object.blocks * sizeof(TriBlock) +
+  size_t bytes = object.inner * exact_node + object.blocks * sizeof(TriBlock) +
                  2 * object.nodes * sizeof(uint32_t);  // entry_of, lane_of
   if (treelets) bytes += object.inner * treelet_node + object.nodes * sizeof(uint32_t);  // wide_of
   if (accel.spec.two_level()) {
     const BvhShape top = bvh_shape(accel.top_nodes);
-    bytes += exact_nodes(top.leaves) * exact_node + top.nodes * sizeof(uint32_t);
+    bytes += top.inner * exact_node + top.nodes * sizeof(uint32_t);
     if (treelets) bytes += top.inner * treelet_node + top.nodes * sizeof(uint32_t);
   }
   return bytes;

@@ -39,11 +39,11 @@ StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSp
 void check_structure_budget(const Scene& scene, const StructureSpec& spec, const LsOptions& ls);
 
 // Upper bound of the bytes of the fast path's trees and triangle blocks (FastTracer::bytes()) for a
-// built structure, from the shape of its binary BVHs: the order-free tree's nodes (each has the
-// width's children, or fewer and all of them leaves, at least two; so with L leaves at most
-// L W / (2 (W - 1)) nodes, and its leaves are at most the binary leaves), one treelet per binary inner
-// node at most (Line Space structures), ceil(count / 4) blocks per binary leaf at most, and one index
-// entry per binary node for each of them.  Built after the BVH, checked before the fast path is made:
+// built structure, from the shape of its binary BVHs: the order-free tree's nodes (one per binary
+// inner node at most: each is made from a distinct one), one treelet per binary inner node at most
+// (Line Space structures), ceil(count / 4) blocks per binary leaf at most (a leaf of the order-free
+// tree takes no more blocks than the binary leaves it joins), and one index entry per binary node
+// for each of them.  Built after the BVH, checked before the fast path is made:
 // estimate_structure_bytes() covers the BVH's build, not these.
 struct Accel;
 size_t fast_path_bytes_at_most(const Accel& accel, int width, int exact_width);

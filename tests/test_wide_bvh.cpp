@@ -610,11 +610,10 @@ void check_exact_tree() {
           return a.nodes[c].count > 0 ? a.nodes[c].count : range_count(a.nodes[c].first) + range_count(a.nodes[c].first + 1);
         };
         std::map<uint32_t, int> seen;
-        size_t outside = 0, unused_not_nan = 0, narrow = 0, underfilled = 0, big_merged = 0;
+        size_t outside = 0, unused_not_nan = 0, narrow = 0, big_merged = 0;
         std::function<void(uint32_t)> visit = [&](uint32_t w) {
           const ls::ExactWideNode<W>& node = tree.nodes[w];
           int used = 0;
-          int inner = 0;
           for (int l = 0; l < W; ++l) {
             if (node.child[l] == lsk::LS_INVALID) {
               unused_not_nan += !std::isnan(node.lo[0][l]) || !std::isnan(node.hi[2][l]);
@@ -622,7 +621,6 @@ void check_exact_tree() {
             }
             ++used;
             if (node.count[l] == 0) {
-              ++inner;
               visit(node.child[l]);
               continue;
             }
@@ -636,14 +634,12 @@ void check_exact_tree() {
                 for (int ax = 0; ax < 3; ++ax) outside += (*v)[ax] < node.lo[ax][l] || (*v)[ax] > node.hi[ax][l];
             }
           }
-          narrow += used < 2;
-          underfilled += used < W && inner > 0;  // the collapse opens inner children while it has room
+          narrow += used < 2;  // (which lanes, and how full: the least-cost test below)
         };
         visit(tree.entry_of[b]);
         CHECK(outside == 0);
         CHECK(unused_not_nan == 0);
         CHECK(narrow == 0);
-        CHECK(underfilled == 0);
         CHECK(big_merged == 0);
         CHECK(seen.size() == range_count(b));
         size_t repeated = 0;
@@ -658,6 +654,131 @@ void check_exact_tree() {
 TEST_CASE("exact wide tree: entries, leaves and boxes, 4 and 8 wide", "[wide]") {
   check_exact_tree<4>();
   check_exact_tree<8>();
+}
+
+// The surface area heuristic's cost of the wide tree below entry node b (ExactWideTree's model:
+// kNodeCost per wide node, kBlockCost per block of four triangles, each by the half area of its
+// box), read off the built tree.
+double half_area(const glm::vec3& lo, const glm::vec3& hi) {
+  const double x = double(hi.x) - double(lo.x), y = double(hi.y) - double(lo.y), z = double(hi.z) - double(lo.z);
+  return x * y + y * z + z * x;
+}
+
+template <int W>
+double built_cost(const ls::ExactWideTree<W>& tree, ls::ExactLeaves leaves, uint32_t wide, double area) {
+  using Tree = ls::ExactWideTree<W>;
+  double cost = area * Tree::kNodeCost;
+  const ls::ExactWideNode<W>& node = tree.nodes[wide];
+  for (int l = 0; l < W; ++l) {
+    if (node.child[l] == lsk::LS_INVALID) continue;
+    const double a = half_area(glm::vec3(node.lo[0][l], node.lo[1][l], node.lo[2][l]),
+                               glm::vec3(node.hi[0][l], node.hi[1][l], node.hi[2][l]));
+    cost += node.count[l] > 0 ? a * Tree::leaf_cost(leaves, node.count[l]) : built_cost(tree, leaves, node.child[l], a);
+  }
+  return cost;
+}
+
+// The least cost of any collapse of b's subtree into a wide node, by exhaustion: every *cut* of
+// the subtree below b (a set of descendants that covers each leaf once) of at most W nodes is a
+// choice of lanes, and each lane is, at the least cost, a leaf (a binary leaf, or a subtree of at
+// most kLeafMax triangles) or a wide node of its own.
+template <int W>
+struct CollapseByExhaustion {
+  using Tree = ls::ExactWideTree<W>;
+  const std::vector<lsk::BvhNode>& nodes;
+  ls::ExactLeaves leaves;
+  std::map<uint32_t, double> lane_memo;
+
+  double area(uint32_t b) const { return half_area(nodes[b].lo, nodes[b].hi); }
+  uint32_t count(uint32_t b) const {
+    return nodes[b].count > 0 ? nodes[b].count : count(nodes[b].first) + count(nodes[b].first + 1);
+  }
+  // Every cut of b's subtree of at most k nodes, as the node lists.
+  std::vector<std::vector<uint32_t>> cuts(uint32_t b, int k) const {
+    std::vector<std::vector<uint32_t>> out{{b}};
+    if (nodes[b].count > 0 || k < 2) return out;
+    for (const auto& left : cuts(nodes[b].first, k - 1))
+      for (const auto& right : cuts(nodes[b].first + 1, k - int(left.size()))) {
+        out.push_back(left);
+        out.back().insert(out.back().end(), right.begin(), right.end());
+      }
+    return out;
+  }
+  double as_node(uint32_t b) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& cut : cuts(b, W)) {
+      if (cut.size() < 2) continue;  // {b} itself is no division
+      double sum = 0.0;
+      for (uint32_t c : cut) sum += as_lane(c);
+      best = std::min(best, sum);
+    }
+    return area(b) * Tree::kNodeCost + best;
+  }
+  double as_lane(uint32_t b) {
+    if (auto it = lane_memo.find(b); it != lane_memo.end()) return it->second;
+    const uint32_t n = count(b);
+    double best = std::numeric_limits<double>::infinity();
+    if (nodes[b].count > 0 || n <= Tree::kLeafMax) best = area(b) * Tree::leaf_cost(leaves, n);
+    if (nodes[b].count == 0) best = std::min(best, as_node(b));
+    return lane_memo[b] = best;
+  }
+};
+
+template <int W>
+void check_least_cost(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
+                      const std::vector<uint32_t>& roots, ls::ExactLeaves leaves, const std::string& what);
+
+// The object BVHs' exact tree (triangles) and, for a two-level structure, its top level's (instances).
+template <int W>
+void check_least_cost(const ls::Accel& a, const std::string& what) {
+  const std::vector<uint32_t>& node_ls = a.spec.line_space() ? a.node_ls : std::vector<uint32_t>{};
+  const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
+  check_least_cost<W>(a.nodes, node_ls, roots, ls::ExactLeaves::Triangles, what);
+  if (a.spec.two_level()) check_least_cost<W>(a.top_nodes, {}, {0u}, ls::ExactLeaves::Instances, what + ", top level");
+}
+
+template <int W>
+void check_least_cost(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
+                      const std::vector<uint32_t>& roots, ls::ExactLeaves leaves, const std::string& what) {
+  const ls::ExactWideTree<W> tree = ls::build_exact_wide_tree<W>(nodes, node_ls, roots, leaves);
+  CollapseByExhaustion<W> exhaustion{nodes, leaves, {}};
+  size_t entries = 0, costlier = 0;
+  std::string first;
+  for (uint32_t b = 0; b < nodes.size(); ++b) {
+    if (tree.entry_of[b] == lsk::LS_INVALID) continue;
+    ++entries;
+    const double built = built_cost(tree, leaves, tree.entry_of[b], exhaustion.area(b));
+    const double least = exhaustion.as_node(b);
+    if (!(std::abs(built - least) <= 1e-9 * least) && costlier++ == 0)
+      first = "entry " + std::to_string(b) + ": built " + std::to_string(built) + ", least " + std::to_string(least);
+  }
+  INFO(what << ", " << W << "-wide: " << first);
+  CHECK(entries > 0);
+  CHECK(costlier == 0);
+}
+
+TEST_CASE("exact wide tree: each entry's collapse costs the least of all collapses (by exhaustion), 4 and 8 wide", "[wide]") {
+  Rng rng(5);
+  for (int k = 0; k < 4; ++k) {  // triangle soups of 40 to 160, dense (merged leaves) and sparse
+    ls::Scene scene;
+    scene.name = "soup";
+    scene.materials.push_back(ls::Material{});
+    scene.meshes.push_back(soup(size_t(40 + 40 * k), rng, 1.0f, k % 2 == 0 ? 0.3f : 0.05f));
+    scene.meshes.push_back(grid(3 + k));  // flat boxes
+    for (uint32_t i = 0; i < uint32_t(8 + 16 * k); ++i) {  // a top level of 8 to 56 instances
+      ls::Instance inst;
+      inst.mesh = i % 2;
+      inst.object_to_world = glm::translate(glm::mat4(1.0f), rng.vec(-4.0f, 4.0f));
+      scene.instances.push_back(inst);
+    }
+    ls::validate_scene(scene);
+    for (const char* s : {"bvh", "2l-bvh", "f-ls:3:2"}) {
+      const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
+      const std::string what = std::string(s) + ", soup " + std::to_string(k);
+      check_least_cost<4>(a, what);
+      check_least_cost<8>(a, what);
+    }
+  }
 }
 
 // The exact tree and the blocks of `accel` built again, on one thread or on all.
