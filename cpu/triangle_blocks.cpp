@@ -4,6 +4,9 @@
 #include "huge_pages.h"
 #include "parallel.h"
 
+#include <algorithm>
+#include <array>
+
 namespace ls {
 
 template <int W>
@@ -13,26 +16,49 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
     uint32_t first;
     uint32_t count;
   };
-  std::vector<Range> ranges;  // each gets blocks of its own, lanes past its end unused
-  std::vector<uint32_t*> exact_children;
-  for (ExactWideNode<W>& node : exact.nodes)
-    for (int l = 0; l < W; ++l)
-      if (node.count[l] > 0) {
-        ranges.push_back(Range{node.child[l], node.count[l]});
-        exact_children.push_back(&node.child[l]);
-      }
-  // The lane of every triangle inside an exact leaf, then the binary leaves outside them.
+  std::vector<Range> ranges;
   std::vector<uint32_t> lane_of_tri(tris.size(), lsk::LS_INVALID);
-  size_t lanes = 0;
-  for (size_t r = 0; r < ranges.size(); ++r) {
-    *exact_children[r] = uint32_t(lanes);
-    for (uint32_t k = 0; k < ranges[r].count; ++k) lane_of_tri[ranges[r].first + k] = uint32_t(lanes + k);
-    lanes += (ranges[r].count + 3u) / 4u * 4u;
+  size_t lanes = 0;  // lanes placed so far; blocks are lanes / 4
+  auto place = [&](const Range& range, size_t first_lane) {
+    for (uint32_t k = 0; k < range.count; ++k) lane_of_tri[range.first + k] = uint32_t(first_lane + k);
+    ranges.push_back(range);
+  };
+  // The leaves of each exact wide node share its blocks: those of at most four triangles packed
+  // first fit, largest first, so none straddles two blocks; a longer one takes blocks of its own.
+  for (ExactWideNode<W>& node : exact.nodes) {
+    std::array<int, W> order;
+    int leaves = 0;
+    for (int l = 0; l < W; ++l)
+      if (node.count[l] > 0) order[size_t(leaves++)] = l;
+    std::stable_sort(order.begin(), order.begin() + leaves, [&](int a, int b) { return node.count[a] > node.count[b]; });
+    size_t first_block = 0;  // set when the first block opens, after the longer leaves (sorted first)
+    std::array<uint32_t, W> used{};  // lanes taken in each block opened for this node's short leaves
+    size_t opened = 0;
+    for (int k = 0; k < leaves; ++k) {
+      uint32_t& child = node.child[order[size_t(k)]];
+      const Range range{child, node.count[order[size_t(k)]]};
+      size_t lane;
+      if (range.count > 4u) {
+        lane = lanes;
+        lanes += (range.count + 3u) / 4u * 4u;
+      } else {
+        size_t b = 0;
+        while (b < opened && used[b] + range.count > 4u) ++b;
+        if (b == opened) {
+          if (opened == 0) first_block = lanes / 4u;
+          used[opened++] = 0;
+          lanes += 4u;
+        }
+        lane = (first_block + b) * 4u + used[b];
+        used[b] += range.count;
+      }
+      child = uint32_t(lane);
+      place(range, lane);
+    }
   }
-  for (const lsk::BvhNode& n : nodes)
+  for (const lsk::BvhNode& n : nodes)  // the binary leaves outside them (the treelets')
     if (n.count > 0 && lane_of_tri[n.first] == lsk::LS_INVALID) {
-      ranges.push_back(Range{n.first, n.count});
-      for (uint32_t k = 0; k < n.count; ++k) lane_of_tri[n.first + k] = uint32_t(lanes + k);
+      place(Range{n.first, n.count}, lanes);
       lanes += (n.count + 3u) / 4u * 4u;
     }
   TriangleBlocks out;
@@ -54,11 +80,9 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
         for (int a = 0; a < 3; ++a) block.v[p][a][lane % 4u] = (*v[p])[a];
       block.prim[lane % 4u] = i;
     }
-    // The range's blocks are its own (its first lane is a multiple of 4): their normals four at a
-    // time, which took half of this function's time one by one.
-    const uint32_t first = lane_of_tri[ranges[r].first] / 4u;
-    for (uint32_t b = first; b < first + (ranges[r].count + 3u) / 4u; ++b) block_lanes::plane_normals(out.blocks[b]);
   });
+  // The normals four at a time, which took half of this function's time one by one.
+  ls::parallel_for(size_t(0), out.blocks.size(), [&](size_t b) { block_lanes::plane_normals(out.blocks[b]); });
   return out;
 }
 

@@ -30,10 +30,13 @@ struct alignas(16) TriBlock {
   uint32_t prim[4];
 };
 
-// The triangles of one BVH array in blocks: each leaf of its exact wide tree gets blocks of its own
-// (its child becomes the leaf's first lane index), and so does every binary leaf outside them (the
-// treelets' leaves above the entries).  A binary leaf inside an exact leaf is a run of that leaf's
-// lanes: its triangles stay in the builder's order either way.
+// The triangles of one BVH array in blocks.  The leaves of each exact wide node share its blocks:
+// those of at most four triangles packed first fit, largest first, so that none straddles two
+// blocks and a ray that hits two of them may find one block loaded already; a longer leaf gets
+// blocks of its own.  A leaf's child becomes its first lane index.  Every binary leaf outside the
+// exact leaves (the treelets' leaves above the entries) gets blocks of its own.  A binary leaf
+// inside an exact leaf is a run of that leaf's lanes: its triangles stay in the builder's order
+// either way.
 struct TriangleBlocks {
   std::vector<TriBlock> blocks;
   std::vector<uint32_t> lane_of;  // per binary node: a leaf's first lane index; LS_INVALID for inner nodes

@@ -781,6 +781,48 @@ TEST_CASE("exact wide tree: each entry's collapse costs the least of all collaps
   }
 }
 
+TEST_CASE("triangle blocks: an exact wide node's short leaves share its blocks, none straddles two", "[wide]") {
+  const ls::Scene scene = ls::load_scene("builtin:generated:20000:7:3");
+  for (const char* s : {"bvh", "2l-bvh", "f-ls:6:3"}) {
+    INFO(s);
+    const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(8));
+    const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
+    ls::ExactWideTree<8> tree = ls::build_exact_wide_tree<8>(a.nodes, a.spec.line_space() ? a.node_ls : std::vector<uint32_t>{}, roots);
+    const std::vector<ls::ExactWideNode<8>> unplaced = tree.nodes;  // leaf children: first triangles
+    const ls::TriangleBlocks blocks = ls::build_triangle_blocks<8>(a.nodes, a.tris, tree);
+    size_t leaves = 0, triangles = 0, wrong_lane = 0, straddling = 0, shared_with_other_node = 0, unpacked_blocks = 0;
+    std::map<size_t, size_t> owner;  // block -> the wide node whose leaves use it
+    for (size_t w = 0; w < tree.nodes.size(); ++w) {
+      size_t short_lanes = 0;
+      for (int l = 0; l < 8; ++l) {
+        const uint32_t count = tree.nodes[w].count[l];
+        if (count == 0) continue;
+        ++leaves;
+        const uint32_t lane = tree.nodes[w].child[l];
+        for (uint32_t k = 0; k < count; ++k) {  // the leaf's triangles, in order, from its first lane
+          ++triangles;
+          wrong_lane += blocks.blocks[(lane + k) / 4u].prim[(lane + k) % 4u] != unplaced[w].child[l] + k;
+        }
+        if (count <= 4u) {
+          straddling += lane / 4u != (lane + count - 1u) / 4u;
+          short_lanes += count;
+        }
+        unpacked_blocks += (count + 3u) / 4u;
+        for (uint32_t b = lane / 4u; b <= (lane + count - 1u) / 4u; ++b)
+          shared_with_other_node += !owner.emplace(b, w).second && owner[b] != w;
+      }
+    }
+    CHECK(leaves > 0);
+    CHECK(wrong_lane == 0);
+    CHECK(straddling == 0);
+    CHECK(shared_with_other_node == 0);
+    CHECK(owner.size() < unpacked_blocks);  // packing saved blocks
+    // Every triangle of a flat exact structure (Line Space structures keep some above their entries,
+    // and a two-level one an object whose root is a leaf).
+    if (std::string(s) == "bvh") CHECK(triangles == a.tris.size());
+  }
+}
+
 // The exact tree and the blocks of `accel` built again, on one thread or on all.
 template <int W>
 std::pair<ls::ExactWideTree<W>, ls::TriangleBlocks> rebuild_fast_layout(const ls::Accel& a, int threads) {
