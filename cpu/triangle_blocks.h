@@ -14,6 +14,7 @@
 #include "simd.h"
 #include "trace_context.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <limits>
@@ -145,10 +146,13 @@ LS_ALWAYS_INLINE void make_block_ray(const lsk::vec3& origin, const lsk::vec3& d
   const float ax = std::abs(d[0]);
   const float ay = std::abs(d[1]);
   const float az = std::abs(d[2]);
-  const uint32_t kz = ax >= ay ? (ax >= az ? 0u : 2u) : (ay >= az ? 1u : 2u);
-  uint32_t kx = kz == 2u ? 0u : kz + 1u;
-  uint32_t ky = kx == 2u ? 0u : kx + 1u;
-  if (d[kz] < 0.0f) std::swap(kx, ky);  // keep the winding, as the kernel does
+  // The kernel's choice, ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2), and its winding swap,
+  // read from tables by the three comparisons: as branches they were mispredicted about once a ray.
+  static constexpr uint8_t kz_of[8] = {2, 1, 2, 1, 2, 2, 0, 0};  // index: (ax >= ay) * 4 + (ax >= az) * 2 + (ay >= az)
+  const uint32_t kz = kz_of[unsigned(ax >= ay) * 4u + unsigned(ax >= az) * 2u + unsigned(ay >= az)];
+  const bool swap = d[kz] < 0.0f;  // keep the winding, as the kernel does
+  const uint32_t kx = (kz + 1u + uint32_t(swap)) % 3u;
+  const uint32_t ky = (kz + 2u - uint32_t(swap)) % 3u;
   alignas(16) float shear[4] = {d[kx], d[ky], 1.0f, 1.0f};
   (Float4::load_aligned(shear) / Float4(d[kz])).store_aligned(shear);  // sx, sy, sz
   r.origin = origin;
@@ -299,8 +303,7 @@ LS_ALWAYS_INLINE unsigned block_distances(const TriBlock& block, const BlockRay&
   for (uint32_t at = lane, end = lane + count; at < end; at = (at | 3u) + 1u) {
     const TriBlock& blk = blocks[at / 4u];
     block_edges(blk, block_ray, e);
-    unsigned in_leaf = 15u << (at % 4u);
-    if (end - (at & ~3u) < 4u) in_leaf &= (1u << (end - (at & ~3u))) - 1u;
+    const unsigned in_leaf = (15u << (at % 4u)) & ((1u << std::min(end - (at & ~3u), 4u)) - 1u);  // no branch
     const unsigned finish = e.finish & in_leaf;
     unsigned lanes = (e.full & in_leaf) | (finish != 0u ? block_distances(blk, block_ray, e, tmin, hit.t, finish) : 0u);
     while (lanes != 0u) {
