@@ -18,7 +18,7 @@
 // primitives become one leaf: four triangles cost one SIMD test whether they sit in one binary leaf
 // or in three, and a level less is a load less).  It replaced a greedy collapse (open the child of
 // largest area while there is room), whose bottom levels were wide nodes of two or three leaves:
-// on builtin:generated:143000:49:1, 14,618 nodes, half of them with two lanes, against 8,732 now
+// on builtin:generated:143000:49:1, 14,618 nodes, 44 % of them with two lanes, against 8,736 now
 // (docs/performance.md).
 #pragma once
 

@@ -656,9 +656,9 @@ TEST_CASE("exact wide tree: entries, leaves and boxes, 4 and 8 wide", "[wide]") 
   check_exact_tree<8>();
 }
 
-// The surface area heuristic's cost of the wide tree below entry node b (ExactWideTree's model:
-// kNodeCost per wide node, kBlockCost per block of four triangles, each by the half area of its
-// box), read off the built tree.
+// The surface area heuristic's cost of the wide tree below an entry (ExactWideTree's model:
+// kNodeCost per wide node, leaf_cost per leaf, each by the half area of its box), read off the
+// built tree.
 double half_area(const glm::vec3& lo, const glm::vec3& hi) {
   const double x = double(hi.x) - double(lo.x), y = double(hi.y) - double(lo.y), z = double(hi.z) - double(lo.z);
   return x * y + y * z + z * x;
