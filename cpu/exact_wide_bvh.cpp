@@ -40,10 +40,11 @@ struct Collapser {
   // "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017, section
   // 3.1): cost[i - 1] of b is the least cost of b's subtree given as at most i lanes of its wide
   // parent, in half-area units with ExactWideTree's kNodeCost per wide node and leaf_cost per leaf
-  // (its blocks of triangles, or its instances).  One lane is b itself, as a leaf or as a wide node; more divide the lanes between b's
-  // two children.  split[b][i - 1], for i >= 2, is how many of those i the first child gets, 0
-  // where i - 1 lanes cost as little; split[b][0] is that division for b's own wide node, kWidth
-  // lanes.  Marks merge[b].  In doubles: the half areas of huge boxes overflow a float.
+  // (its blocks of triangles, or its instances).  One lane is b itself, as a leaf or as a wide
+  // node; more divide the lanes between b's two children.  split[b][i - 1], for i >= 2, is how many
+  // of those i the first child gets, 0 where i - 1 lanes cost as little; split[b][0] is that
+  // division for b's own wide node, kWidth lanes.  Marks merge[b].  In doubles: the half areas of
+  // huge boxes overflow a float.
   using Costs = std::array<double, kWidth>;
   std::vector<std::array<uint8_t, kWidth>> split;
 
@@ -85,7 +86,8 @@ struct Collapser {
       }
     }
     const double as_node = area * Tree::kNodeCost + divided[kWidth];
-    const double as_leaf = count <= Tree::kLeafMax ? area * Tree::leaf_cost(leaves, count) : std::numeric_limits<double>::infinity();
+    const double as_leaf =
+        count <= Tree::kLeafMax ? area * Tree::leaf_cost(leaves, count) : std::numeric_limits<double>::infinity();
     merge[b] = as_leaf <= as_node;
     cost[0] = merge[b] ? as_leaf : as_node;
     split[b][0] = divided_k[kWidth];

@@ -31,8 +31,8 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
     for (int l = 0; l < W; ++l)
       if (node.count[l] > 0) order[size_t(leaves++)] = l;
     std::stable_sort(order.begin(), order.begin() + leaves, [&](int a, int b) { return node.count[a] > node.count[b]; });
-    size_t first_block = 0;  // set when the first block opens, after the longer leaves (sorted first)
-    std::array<uint32_t, W> used{};  // lanes taken in each block opened for this node's short leaves
+    std::array<size_t, W> opened_block{};  // the blocks opened for this node's short leaves
+    std::array<uint32_t, W> used{};        // and the lanes taken in each
     size_t opened = 0;
     for (int k = 0; k < leaves; ++k) {
       uint32_t& child = node.child[order[size_t(k)]];
@@ -45,11 +45,11 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
         size_t b = 0;
         while (b < opened && used[b] + range.count > 4u) ++b;
         if (b == opened) {
-          if (opened == 0) first_block = lanes / 4u;
+          opened_block[opened] = lanes / 4u;
           used[opened++] = 0;
           lanes += 4u;
         }
-        lane = (first_block + b) * 4u + used[b];
+        lane = opened_block[b] * 4u + used[b];
         used[b] += range.count;
       }
       child = uint32_t(lane);

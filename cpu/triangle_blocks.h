@@ -146,8 +146,9 @@ LS_ALWAYS_INLINE void make_block_ray(const lsk::vec3& origin, const lsk::vec3& d
   const float ax = std::abs(d[0]);
   const float ay = std::abs(d[1]);
   const float az = std::abs(d[2]);
-  // The kernel's choice, ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2), and its winding swap,
-  // read from tables by the three comparisons: as branches they were mispredicted about once a ray.
+  // The kernel's choice, ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2), read from a table by
+  // the three comparisons, and its winding swap by arithmetic: as branches they were mispredicted
+  // about once a ray.
   static constexpr uint8_t kz_of[8] = {2, 1, 2, 1, 2, 2, 0, 0};  // index: (ax >= ay) * 4 + (ax >= az) * 2 + (ay >= az)
   const uint32_t kz = kz_of[unsigned(ax >= ay) * 4u + unsigned(ax >= az) * 2u + unsigned(ay >= az)];
   const bool swap = d[kz] < 0.0f;  // keep the winding, as the kernel does

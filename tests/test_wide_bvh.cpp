@@ -656,14 +656,15 @@ TEST_CASE("exact wide tree: entries, leaves and boxes, 4 and 8 wide", "[wide]") 
   check_exact_tree<8>();
 }
 
-// The surface area heuristic's cost of the wide tree below an entry (ExactWideTree's model:
-// kNodeCost per wide node, leaf_cost per leaf, each by the half area of its box), read off the
-// built tree.
+// A box's half area, in doubles as the collapse takes it.
 double half_area(const glm::vec3& lo, const glm::vec3& hi) {
   const double x = double(hi.x) - double(lo.x), y = double(hi.y) - double(lo.y), z = double(hi.z) - double(lo.z);
   return x * y + y * z + z * x;
 }
 
+// The surface area heuristic's cost of the wide tree below an entry (ExactWideTree's model:
+// kNodeCost per wide node, leaf_cost per leaf, each by the half area of its box), read off the
+// built tree.
 template <int W>
 double built_cost(const ls::ExactWideTree<W>& tree, ls::ExactLeaves leaves, uint32_t wide, double area) {
   using Tree = ls::ExactWideTree<W>;
@@ -726,19 +727,6 @@ struct CollapseByExhaustion {
 
 template <int W>
 void check_least_cost(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
-                      const std::vector<uint32_t>& roots, ls::ExactLeaves leaves, const std::string& what);
-
-// The object BVHs' exact tree (triangles) and, for a two-level structure, its top level's (instances).
-template <int W>
-void check_least_cost(const ls::Accel& a, const std::string& what) {
-  const std::vector<uint32_t>& node_ls = a.spec.line_space() ? a.node_ls : std::vector<uint32_t>{};
-  const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
-  check_least_cost<W>(a.nodes, node_ls, roots, ls::ExactLeaves::Triangles, what);
-  if (a.spec.two_level()) check_least_cost<W>(a.top_nodes, {}, {0u}, ls::ExactLeaves::Instances, what + ", top level");
-}
-
-template <int W>
-void check_least_cost(const std::vector<lsk::BvhNode>& nodes, const std::vector<uint32_t>& node_ls,
                       const std::vector<uint32_t>& roots, ls::ExactLeaves leaves, const std::string& what) {
   const ls::ExactWideTree<W> tree = ls::build_exact_wide_tree<W>(nodes, node_ls, roots, leaves);
   CollapseByExhaustion<W> exhaustion{nodes, leaves, {}};
@@ -755,6 +743,15 @@ void check_least_cost(const std::vector<lsk::BvhNode>& nodes, const std::vector<
   INFO(what << ", " << W << "-wide: " << first);
   CHECK(entries > 0);
   CHECK(costlier == 0);
+}
+
+// The object BVHs' exact tree (triangles) and, for a two-level structure, its top level's (instances).
+template <int W>
+void check_least_cost(const ls::Accel& a, const std::string& what) {
+  const std::vector<uint32_t>& node_ls = a.spec.line_space() ? a.node_ls : std::vector<uint32_t>{};
+  const std::vector<uint32_t> roots = a.spec.two_level() ? a.object_roots : std::vector<uint32_t>{0u};
+  check_least_cost<W>(a.nodes, node_ls, roots, ls::ExactLeaves::Triangles, what);
+  if (a.spec.two_level()) check_least_cost<W>(a.top_nodes, {}, {0u}, ls::ExactLeaves::Instances, what + ", top level");
 }
 
 TEST_CASE("exact wide tree: each entry's collapse costs the least of all collapses (by exhaustion), 4 and 8 wide", "[wide]") {
@@ -793,7 +790,6 @@ TEST_CASE("triangle blocks: an exact wide node's short leaves share its blocks, 
     size_t leaves = 0, triangles = 0, wrong_lane = 0, straddling = 0, shared_with_other_node = 0, unpacked_blocks = 0;
     std::map<size_t, size_t> owner;  // block -> the wide node whose leaves use it
     for (size_t w = 0; w < tree.nodes.size(); ++w) {
-      size_t short_lanes = 0;
       for (int l = 0; l < 8; ++l) {
         const uint32_t count = tree.nodes[w].count[l];
         if (count == 0) continue;
@@ -803,10 +799,7 @@ TEST_CASE("triangle blocks: an exact wide node's short leaves share its blocks, 
           ++triangles;
           wrong_lane += blocks.blocks[(lane + k) / 4u].prim[(lane + k) % 4u] != unplaced[w].child[l] + k;
         }
-        if (count <= 4u) {
-          straddling += lane / 4u != (lane + count - 1u) / 4u;
-          short_lanes += count;
-        }
+        if (count <= 4u) straddling += lane / 4u != (lane + count - 1u) / 4u;
         unpacked_blocks += (count + 3u) / 4u;
         for (uint32_t b = lane / 4u; b <= (lane + count - 1u) / 4u; ++b)
           shared_with_other_node += !owner.emplace(b, w).second && owner[b] != w;
