@@ -154,6 +154,11 @@ LS_ALWAYS_INLINE void box_tests(const WideNode<K>& node, const SlabRay<FloatBatc
   }
 }
 
+// lsk::widen_distance with |t| taken by clearing the sign bit: glm's abs (t >= 0 ? t : -t) is a
+// branch, which a walk's pops mispredicted about once a ray.  The two differ only in the sign of a
+// zero or a NaN, which no comparison sees.
+LS_ALWAYS_INLINE float widen_limit(float t) { return t + std::fabs(t) * lsk::LS_WIDEN_SLACK; }
+
 // What a node visit asks of the traversal.
 enum class Visit { Descend, Skip, Stop };
 
@@ -199,7 +204,7 @@ inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray
       }
       const float* tn = tnear[depth];
       const float* tf = tfar[depth];
-      const float limit = lsk::widen_distance(hit.t);
+      const float limit = widen_limit(hit.t);
       const uint c0 = 2u * pos;
       const uint c1 = c0 + 1u;
       const float tn0 = tn[c0 - 2u];
@@ -233,7 +238,7 @@ inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray
     }
     // Pop the nearest pending node that can still hold something closer than the current hit.
     bool found = false;
-    const float limit = lsk::widen_distance(hit.t);
+    const float limit = widen_limit(hit.t);
     while (sp > 0 && !found) {
       --sp;
       if (stack_t[sp] <= limit) {
@@ -246,11 +251,6 @@ inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray
     if (!found) return false;
   }
 }
-
-// lsk::widen_distance with |t| taken by clearing the sign bit: glm's abs (t >= 0 ? t : -t) is a
-// branch, which a walk's pops mispredicted about once a ray.  The two differ only in the sign of a
-// zero or a NaN, which no comparison sees.
-LS_ALWAYS_INLINE float widen_limit(float t) { return t + std::fabs(t) * lsk::LS_WIDEN_SLACK; }
 
 // The batch an exact W-wide node's boxes are tested in: 4 floats, or 8 where the build has AVX and
 // W = 8 (an 8-wide node on SSE2 takes two batches).
