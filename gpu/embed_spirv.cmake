@@ -8,5 +8,5 @@ if(n EQUAL 0 OR NOT rem EQUAL 0)
 endif()
 # Little-endian bytes b0 b1 b2 b3 -> word 0xb3b2b1b0.
 string(REGEX REPLACE "([0-9a-f][0-9a-f])([0-9a-f][0-9a-f])([0-9a-f][0-9a-f])([0-9a-f][0-9a-f])" "0x\\4\\3\\2\\1u," words "${hex}")
-file(WRITE ${OUTPUT} "// Generated from ${INPUT} by gpu/embed_spirv.cmake.\n#include \"shaders.h\"\n"
+file(WRITE ${OUTPUT} "// Generated from ${INPUT} by gpu/embed_spirv.cmake.\n#include \"gpu/shaders.h\"\n"
      "namespace ls::gpu {\nconst std::vector<uint32_t>& spirv_${NAME}() {\n  static const std::vector<uint32_t> words{${words}};\n  return words;\n}\n}  // namespace ls::gpu\n")

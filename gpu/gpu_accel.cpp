@@ -1,4 +1,6 @@
-#include "gpu_accel.h"
+#include "gpu/gpu_accel.h"
+
+#include "common/structure/accel.h"
 
 namespace ls::gpu {
 

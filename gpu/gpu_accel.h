@@ -2,9 +2,9 @@
 // order of shaders/scene_buffers.glsl.
 #pragma once
 
-#include "accel.h"
-#include "shader_params.h"
-#include "vk_buffer.h"
+#include "common/structure/accel.h"
+#include "gpu/shader_params.h"
+#include "gpu/vk_buffer.h"
 
 #include <vector>
 

@@ -1,8 +1,11 @@
-#include "gpu_line_space.h"
+#include "gpu/gpu_line_space.h"
 
-#include "gpu_accel.h"
-#include "shaders.h"
-#include "vk_pipeline.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/build/line_space_builder.h"
+#include "gpu/gpu_accel.h"
+#include "gpu/shaders.h"
+#include "gpu/vk_pipeline.h"
 
 #include <algorithm>
 #include <chrono>
@@ -69,7 +72,7 @@ Accel build_accel_gpu(const VulkanContext& context, const Scene& scene, const St
   AccelOptions laid_out = options;
   laid_out.search_candidates = false;
   laid_out.fast_path = false;  // the device traces with the shared kernels: the CPU's wide trees would be unused
-  Accel accel = build_accel(scene, spec, laid_out);
+  Accel accel = build_planned_accel(scene, spec, laid_out);
   if (spec.line_space()) {
     search_candidates_gpu(context, accel, timing);
     accel.build_seconds += accel.ls_info.seconds;

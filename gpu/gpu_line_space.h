@@ -3,8 +3,8 @@
 // candidate array equals the CPU's bit for bit.
 #pragma once
 
-#include "accel.h"
-#include "vk_context.h"
+#include "common/structure/accel.h"
+#include "gpu/vk_context.h"
 
 namespace ls::gpu {
 

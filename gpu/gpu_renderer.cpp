@@ -1,9 +1,13 @@
-#include "gpu_renderer.h"
+#include "gpu/gpu_renderer.h"
 
-#include "gpu_line_space.h"
-#include "gpu_trace.h"
-#include "interrupt.h"
-#include "shaders.h"
+#include "common/base/interrupt.h"
+#include "common/render/light_set.h"
+#include "common/render/render_types.h"
+#include "common/render/surface.h"
+#include "common/structure/accel.h"
+#include "gpu/gpu_line_space.h"
+#include "gpu/gpu_trace.h"
+#include "gpu/shaders.h"
 
 #include <algorithm>
 #include <chrono>

@@ -5,9 +5,10 @@
 // numbers and outputs as ls::render (cpu/path_tracer.h); on lavapipe the same images bit for bit.
 #pragma once
 
-#include "gpu_accel.h"
-#include "path_tracer.h"
-#include "vk_context.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "gpu/gpu_accel.h"
+#include "gpu/vk_context.h"
 
 #include <map>
 #include <string>

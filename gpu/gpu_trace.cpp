@@ -1,6 +1,6 @@
-#include "gpu_trace.h"
+#include "gpu/gpu_trace.h"
 
-#include "shaders.h"
+#include "gpu/shaders.h"
 
 #include <chrono>
 

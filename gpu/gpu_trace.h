@@ -2,8 +2,8 @@
 // structures, with the hits and Line Space counters the CPU's ls::trace_rays gives.
 #pragma once
 
-#include "gpu_accel.h"
-#include "vk_pipeline.h"
+#include "gpu/gpu_accel.h"
+#include "gpu/vk_pipeline.h"
 
 #include <vector>
 

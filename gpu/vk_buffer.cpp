@@ -1,6 +1,6 @@
-#include "vk_buffer.h"
+#include "gpu/vk_buffer.h"
 
-#include "scene.h"  // ls::InputError
+#include "common/model/scene.h"
 
 #include <algorithm>
 #include <string>

@@ -4,7 +4,7 @@
 // structure) still binds.
 #pragma once
 
-#include "vk_context.h"
+#include "gpu/vk_context.h"
 
 #include <cstddef>
 #include <cstring>

@@ -1,6 +1,6 @@
-#include "vk_context.h"
+#include "gpu/vk_context.h"
 
-#include "scene.h"  // ls::InputError
+#include "common/model/scene.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,5 @@
-#include "vk_pipeline.h"
+#include "gpu/vk_pipeline.h"
+
 
 namespace ls::gpu {
 

@@ -2,7 +2,7 @@
 // and a timestamp pair to time the kernels recorded between begin() and end().
 #pragma once
 
-#include "vk_buffer.h"
+#include "gpu/vk_buffer.h"
 
 #include <cstdint>
 #include <vector>

@@ -20,9 +20,8 @@
 //
 // Every object is built so that its triangles wind counter-clockwise seen from the side its vertex
 // normals point to (outwards for solids, into the room for walls).
-#include "load_scene.h"
-
-#include "animation.h"
+#include "common/model/animation.h"
+#include "scenes/load_scene.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

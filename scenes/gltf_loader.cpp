@@ -3,7 +3,8 @@
 // tinygltf parses the JSON and the buffers; it does not check that accessors, buffer views and indices
 // stay inside their buffers, so every range is checked here before a byte is read.  Anything the
 // renderer could not trace faithfully is an InputError naming the file and the offending element.
-#include "load_scene.h"
+#include "common/model/animation.h"
+#include "scenes/load_scene.h"
 
 #include <tiny_gltf.h>
 

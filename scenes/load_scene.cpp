@@ -1,5 +1,6 @@
 // Scene specs -> loaders, and the one scene-wide edit (scale_and_offset).
-#include "load_scene.h"
+#include "scenes/load_scene.h"
+
 
 #include <glm/gtc/matrix_transform.hpp>
 

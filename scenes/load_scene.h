@@ -3,7 +3,7 @@
 // passed validate_scene().
 #pragma once
 
-#include "scene.h"
+#include "common/model/scene.h"
 
 #include <cstdint>
 #include <string>

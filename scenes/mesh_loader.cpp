@@ -8,7 +8,7 @@
 //
 // Normals: the file's where it has them (OBJ vn, OFF NOFF, PLY nx ny nz), made unit; elsewhere
 // area-weighted averages of the faces around each vertex.
-#include "load_scene.h"
+#include "scenes/load_scene.h"
 
 #include <algorithm>
 #include <array>

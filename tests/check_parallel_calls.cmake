@@ -1,4 +1,4 @@
-# Every parallel call goes through cpu/parallel.h (ls::parallel_for, _reduce, _invoke), which tells
+# Every parallel call goes through common/base/parallel.h (ls::parallel_for, _reduce, _invoke), which tells
 # ThreadSanitizer what TBB orders and hides TBB's own code from it; a direct TBB algorithm, task group
 # or arena elsewhere would be unchecked or misreported under TSan.  Run with -DROOT=<source dir>.
 set(pattern "tbb::(parallel_[a-z_]+|task_group|task_arena|flow::)")
@@ -9,17 +9,17 @@ foreach(dir cpu common scenes validate gpu tests)
   foreach(f ${files})
     math(EXPR scanned "${scanned} + 1")
     file(STRINGS "${f}" lines REGEX "${pattern}")
-    if(lines AND NOT f STREQUAL "${ROOT}/cpu/parallel.h")
+    if(lines AND NOT f STREQUAL "${ROOT}/common/base/parallel.h")
       list(APPEND found "${f}: ${lines}")
     endif()
   endforeach()
 endforeach()
-file(STRINGS "${ROOT}/cpu/parallel.h" own REGEX "${pattern}")
+file(STRINGS "${ROOT}/common/base/parallel.h" own REGEX "${pattern}")
 if(scanned LESS 50 OR NOT own)
-  message(FATAL_ERROR "the scan saw ${scanned} files and no TBB call in cpu/parallel.h: it checks nothing")
+  message(FATAL_ERROR "the scan saw ${scanned} files and no TBB call in common/base/parallel.h: it checks nothing")
 endif()
 if(found)
   string(REPLACE ";" "\n" found "${found}")
-  message(FATAL_ERROR "TBB algorithms called outside cpu/parallel.h (use ls::parallel_*):\n${found}")
+  message(FATAL_ERROR "TBB algorithms called outside common/base/parallel.h (use ls::parallel_*):\n${found}")
 endif()
-message(STATUS "${scanned} files: every TBB algorithm is called through cpu/parallel.h")
+message(STATUS "${scanned} files: every TBB algorithm is called through common/base/parallel.h")

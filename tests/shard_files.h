@@ -3,8 +3,8 @@
 // ray counts and Line Space counters.
 #pragma once
 
-#include "image_output.h"
-#include "run_program.h"
+#include "common/render/image_output.h"
+#include "tests/run_program.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

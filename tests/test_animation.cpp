@@ -3,8 +3,9 @@
 // (Appendix C) says — compared with matrices computed by hand here, not with the code's own output —
 // hostile animation data refused with a one-line InputError, morph-target weights, several
 // animations, and the built-in animated scene.
-#include "gltf_writer.h"
-#include "load_scene.h"
+#include "common/model/animation.h"
+#include "scenes/load_scene.h"
+#include "tests/gltf_writer.h"
 
 #include <catch2/catch.hpp>
 

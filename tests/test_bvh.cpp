@@ -3,10 +3,11 @@
 // bookkeeping of flat and two-level structures against hand-built scenes.
 #include <catch2/catch.hpp>
 
-#include "accel.h"
-#include "bvh_builder.h"
-#include "scene.h"
-#include "structure_name.h"
+#include "common/model/scene.h"
+#include "common/model/structure_name.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/bvh_builder.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

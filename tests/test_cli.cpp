@@ -1,7 +1,7 @@
 // linespace-cpu end to end: the file formats, the JSON keys of DESIGN §9, and exit status 2 with a
 // one-line reason on bad input.
-#include "embree_tracer.h"
-#include "gltf_writer.h"
+#include "cpu/trace/embree_tracer.h"
+#include "tests/gltf_writer.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -8,11 +8,13 @@
 //   - same triangle: t agrees on every ray, u and v within 1e-3 on >= 99.9 %;
 //   - any-hit on finite segments (t/2, 2t, shadow-like): occluded-or-not agrees on >= 99.99 %.
 // Counts print as lines starting with "[embree]"; failing rays print in hex for a repro.
-#include "accel.h"
-#include "embree_tracer.h"
-#include "load_scene.h"
-#include "ray_generators.h"
-#include "surface.h"
+#include "common/render/surface.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/trace/embree_tracer.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 #include <tiny_gltf.h>

@@ -1,14 +1,19 @@
 // The Vulkan port against the CPU reference, bit for bit (DESIGN §5, issue 5): Line Space candidates of
 // every shaft, traced hits (closest and any hit, all four structures), and renders.  These run on
 // whatever Vulkan device the machine has (lavapipe in CI); with no device at all they FAIL.
-#include "cross_check.h"
-#include "gpu_line_space.h"
-#include "gpu_renderer.h"
-#include "load_scene.h"
-#include "path_tracer.h"
-#include "ray_generators.h"
-#include "top_level_update.h"
-#include "tile_selection.h"
+#include "common/model/animation.h"
+#include "common/render/render_types.h"
+#include "common/render/tile_selection.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/build/top_level_update.h"
+#include "cpu/render/path_tracer.h"
+#include "cpu/trace/ray_generators.h"
+#include "gpu/gpu_line_space.h"
+#include "gpu/gpu_renderer.h"
+#include "scenes/load_scene.h"
+#include "validate/cross_check.h"
 
 #include <catch2/catch.hpp>
 

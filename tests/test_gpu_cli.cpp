@@ -1,7 +1,7 @@
 // linespace-gpu end to end: bad input exits 2 with a one-line reason (no device or a wrong --device
 // included), and its hit files, build report and render equal linespace-cpu's.
-#include "image_output.h"
-#include "shard_files.h"
+#include "common/render/image_output.h"
+#include "tests/shard_files.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

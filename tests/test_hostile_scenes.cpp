@@ -2,11 +2,15 @@
 // non-triangle mode, float overflow in vertices, transforms and emission, denormal and zero-area
 // geometry, 2^31 triangles, extreme cameras, zero- and huge-power lights.  Each is refused with an
 // InputError naming the file, or loads and renders finite pixels.  Through load_gltf_bytes: no files.
-#include "accel.h"
-#include "gltf_writer.h"
-#include "load_scene.h"
-#include "memory_budget.h"
-#include "path_tracer.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/build/structure_budget.h"
+#include "cpu/render/path_tracer.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
+#include "tests/gltf_writer.h"
 
 #include <catch2/catch.hpp>
 

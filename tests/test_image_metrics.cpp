@@ -1,5 +1,5 @@
-#include "image_metrics.h"
-#include "scene.h"
+#include "common/model/scene.h"
+#include "common/render/image_metrics.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,11 +1,13 @@
 // An interrupt (Ctrl-C) stops builds, renders and output writing with ls::Interrupted, and leaves no
 // output file.  The signal itself is exercised end to end in test_cli; here the pending flag is set
 // directly.
-#include "accel.h"
-#include "image_output.h"
-#include "interrupt.h"
-#include "load_scene.h"
-#include "path_tracer.h"
+#include "common/base/interrupt.h"
+#include "common/render/image_output.h"
+#include "common/render/render_types.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/render/path_tracer.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,9 +1,11 @@
 // The Line Space against brute force and against the exact structures, at the extremes.
-#include "accel.h"
-#include "load_scene.h"
-#include "ray_generators.h"
-#include "trace_context.h"
-#include "kernels/line_space.h"
+#include "common/kernels/line_space.h"
+#include "common/structure/accel.h"
+#include "common/structure/trace_context.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>

@@ -1,11 +1,13 @@
 // Per-object Line Space parameters (LsOptions::objects) and 2l-ls:auto (cpu/ls_budget.h): each object's
 // Line Space equals the one a uniform structure gives it, the budget holds, the pilot's lazily searched
 // shafts answer like a full build, and the optimiser keeps its guarantees against brute force.
-#include "accel.h"
-#include "load_scene.h"
-#include "ls_budget.h"
-#include "memory_budget.h"
-#include "ray_generators.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/build/ls_budget.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 
@@ -112,7 +114,7 @@ TEST_CASE("2l-ls:auto stays within its budget and takes exactly the bytes it pre
   for (double extra_mb : {0.0, 0.02, 0.3, 3.0}) {
     const double mb = double(fixed) / 1e6 + extra_mb;
     INFO("budget " << mb << " MB");
-    const Accel a = build_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
+    const Accel a = build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
     REQUIRE(a.ls_plan);
     CHECK(a.ls_plan->fixed_bytes == fixed);
     CHECK(a.bytes_ls() == a.ls_plan->predicted_bytes);
@@ -130,12 +132,14 @@ TEST_CASE("2l-ls:auto stays within its budget and takes exactly the bytes it pre
 
 TEST_CASE("2l-ls:auto is refused without a budget, below its fixed part, and over --max-memory", "[ls_budget]") {
   const Scene scene = load_scene(kScene);
-  CHECK_THROWS_AS(build_accel(scene, parse_structure("2l-ls:auto")), InputError);
-  CHECK_THROWS_WITH(build_accel(scene, parse_structure("2l-ls:auto"), with_budget(0.01)),
+  CHECK_THROWS_WITH(build_planned_accel(scene, parse_structure("2l-ls:auto")), Catch::Contains("needs a Line Space budget"));
+  // build_accel itself never plans: without a plan it refuses, whatever the budget.
+  CHECK_THROWS_WITH(build_accel(scene, parse_structure("2l-ls:auto"), with_budget(1.0)), Catch::Contains("needs its plan"));
+  CHECK_THROWS_WITH(build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(0.01)),
                     Catch::Contains("raise --ls-budget"));
   AccelOptions small = with_budget(500.0);
   small.ls.max_memory = 100000000;  // 100 MB: the 500 MB budget itself is over it
-  CHECK_THROWS_WITH(build_accel(scene, parse_structure("2l-ls:auto"), small), Catch::Contains("--ls-budget"));
+  CHECK_THROWS_WITH(build_planned_accel(scene, parse_structure("2l-ls:auto"), small), Catch::Contains("--ls-budget"));
   CHECK(parse_structure("2l-ls:auto").name() == "2l-ls:auto");
   CHECK(parse_structure("2L-LS:AUTO").budgeted);
   CHECK_THROWS_AS(parse_structure("f-ls:auto"), InputError);
@@ -148,7 +152,7 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
   const size_t fixed = exact.nodes.size() * 4 + exact.tris.size() * 16;
   const AccelOptions options = with_budget(double(fixed) / 1e6 + 0.8, 6000);
-  const Accel planned = build_accel(scene, parse_structure("2l-ls:auto"), options);
+  const Accel planned = build_planned_accel(scene, parse_structure("2l-ls:auto"), options);
   const LsPlan& plan = *planned.ls_plan;
   REQUIRE(!plan.reference.empty());
   const LsPilot pilot = ls_budget_pilot(scene, exact, options.ls.budget_rays);
@@ -179,8 +183,8 @@ TEST_CASE("2l-ls:auto is deterministic", "[ls_budget]") {
   const Scene scene = load_scene(kScene);
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
   const double mb = double(exact.nodes.size() * 4 + exact.tris.size() * 16) / 1e6 + 0.5;
-  const Accel a = build_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
-  const Accel b = build_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
+  const Accel a = build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
+  const Accel b = build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
   CHECK(a.ls_options.objects == b.ls_options.objects);
   CHECK(a.ls_candidates == b.ls_candidates);
 }

@@ -1,8 +1,12 @@
 // Memory budgets: the estimates are upper bounds of what the structures really take, and over-budget
 // structures and renders are refused from the parameters alone (fast, before allocating).
-#include "accel.h"
-#include "load_scene.h"
-#include "memory_budget.h"
+#include "common/base/memory_budget.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/line_space_builder.h"
+#include "cpu/build/structure_budget.h"
+#include "cpu/trace/fast_path_budget.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 

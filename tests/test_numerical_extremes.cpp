@@ -1,7 +1,9 @@
 // Numerical extremes end to end: builtin:cornell scaled by 1e-20 .. 1e20 and moved 1e6 away renders
 // with finite pixels, and (where float can still represent the scene) the same picture as at scale 1.
-#include "load_scene.h"
-#include "path_tracer.h"
+#include "common/render/render_types.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/render/path_tracer.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 

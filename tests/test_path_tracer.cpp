@@ -1,5 +1,7 @@
 // The path tracer against analytic answers and against itself under other structures.
-#include "path_tracer.h"
+#include "common/render/render_types.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/render/path_tracer.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,11 +1,15 @@
 // Sharded rendering against the single render: tiles cover the image exactly once, renders of tile
 // subsets put together equal the single render bit for bit (images, ray counts, Line Space counters),
 // partials survive the EXR round trip, and merge refuses what does not add up to one render.
-#include "image_output.h"
-#include "load_scene.h"
-#include "merge_partials.h"
-#include "render_partial.h"
-#include "render_shards.h"
+#include "common/render/image_output.h"
+#include "common/render/merge_partials.h"
+#include "common/render/render_partial.h"
+#include "common/render/render_shards.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/render/path_tracer.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 

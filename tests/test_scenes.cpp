@@ -1,7 +1,7 @@
 // Scene loading: built-in scenes, glTF (written here, buffers embedded as base64 data URIs, and a
 // hand-packed .glb), OBJ/OFF/PLY/STL, and every kind of bad input -> InputError.
-#include "gltf_writer.h"
-#include "load_scene.h"
+#include "scenes/load_scene.h"
+#include "tests/gltf_writer.h"
 
 #include <catch2/catch.hpp>
 

@@ -1,7 +1,7 @@
 // Sharded renders through linespace-cpu as a scheduler would run them: `render --shard K/N` or
 // `--tiles A:B` on each "machine", then `merge`; the merged folder must equal the single render's.
 // Bad flags and partials that do not add up to one render exit 2 with a one-line reason.
-#include "shard_files.h"
+#include "tests/shard_files.h"
 
 #include <algorithm>
 #include <array>

@@ -2,8 +2,8 @@
 // round trip, the repeating last entry of a schedule, and the rejections (InputError).
 #include <catch2/catch.hpp>
 
-#include "scene.h"
-#include "structure_name.h"
+#include "common/model/scene.h"
+#include "common/model/structure_name.h"
 
 #include <string>
 #include <vector>

@@ -1,8 +1,8 @@
 // --threads (cpu/thread_limit.h): a limit applies to every parallel call while it lives, is lifted
 // after, and counts outside [0, the process's CPUs] are refused.
-#include "parallel.h"
-#include "scene.h"
-#include "thread_limit.h"
+#include "common/base/parallel.h"
+#include "common/base/thread_limit.h"
+#include "common/model/scene.h"
 
 #include <catch2/catch.hpp>
 #include <tbb/info.h>

@@ -1,8 +1,11 @@
 // The per-path structure choice (render --throughput-switch T:X) against renders that must equal it:
 // a T above every throughput is X from bounce 0, a tiny T is the schedule, switching to the
 // schedule's own structure changes nothing, and bounce 0 (throughput 1) is never switched by T <= 1.
-#include "load_scene.h"
-#include "path_tracer.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/render/path_tracer.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 

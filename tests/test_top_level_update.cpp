@@ -7,10 +7,15 @@
 // float (dyadic translations, 180-degree turns, power-of-two scales), so that a flat and a two-level
 // structure must agree bit for bit; general poses are checked against a two-level structure built
 // from scratch on the posed scene.
-#include "accel.h"
-#include "line_space_builder.h"
-#include "load_scene.h"
-#include "top_level_update.h"
+#include "common/model/animation.h"
+#include "common/structure/accel.h"
+#include "common/structure/top_level.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/line_space_builder.h"
+#include "cpu/build/top_level_update.h"
+#include "cpu/trace/fast_tracer.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 

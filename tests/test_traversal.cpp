@@ -16,13 +16,15 @@
 // Reports carry the bits of the rays and triangles involved, enough to reproduce a failure alone.
 #include <catch2/catch.hpp>
 
-#include "accel.h"
-#include "kernels/offset_ray.h"
-#include "kernels/ray_triangle.h"
-#include "parallel.h"
-#include "scene.h"
-#include "structure_name.h"
-#include "surface.h"
+#include "common/base/parallel.h"
+#include "common/kernels/offset_ray.h"
+#include "common/kernels/ray_triangle.h"
+#include "common/model/scene.h"
+#include "common/model/structure_name.h"
+#include "common/render/surface.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/trace/trace_rays.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 

@@ -1,12 +1,15 @@
 // The validator's studies against what they must show by construction: an approximation that refuses
 // everything has no error, bounces before the switch are untouched, and the heat-map, the Pareto
 // front and the tables agree with independent computations.
-#include "heatmap.h"
-#include "image_metrics.h"
-#include "load_scene.h"
-#include "policy_study.h"
-#include "rmse_study.h"
-#include "sweep.h"
+#include "common/render/image_metrics.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "cpu/app/cpu_backend.h"
+#include "scenes/load_scene.h"
+#include "validate/heatmap.h"
+#include "validate/policy_study.h"
+#include "validate/rmse_study.h"
+#include "validate/sweep.h"
 
 #include <catch2/catch.hpp>
 
@@ -36,7 +39,7 @@ TEST_CASE("refusal angle 0: every Line Space gives RMSE 0 on every bounce", "[va
   AccelOptions options;
   options.ls.angle_degrees = 0.0f;
   options.ls.min_triangles = 0;
-  CpuStudyRenderer renderer(scene, options);
+  StudyRenderer renderer(make_cpu_backend(), scene, options);
   const RmseStudy study = run_rmse_study(renderer, "builtin:cornell", parse_structure_list("f-ls:6:4,2l-ls:2:4"),
                                          tiny_image(), "", 0.1f, quiet);
   REQUIRE(study.rows.size() == 6);
@@ -53,7 +56,7 @@ TEST_CASE("switching to the Line Space at bounce k leaves the bounces before k b
   const Scene scene = load_scene("builtin:cornell");
   AccelOptions options;
   options.ls.min_triangles = 0;
-  CpuStudyRenderer renderer(scene, options);
+  StudyRenderer renderer(make_cpu_backend(), scene, options);
   const ImageSettings settings = tiny_image();
   const Reference reference = render_reference(renderer, settings);
   const StructureSpec ls = parse_structure("f-ls:8:6");
@@ -70,7 +73,7 @@ TEST_CASE("switching to the Line Space at bounce k leaves the bounces before k b
 
 TEST_CASE("the rmse study's figures equal a direct computation from the two renders", "[validate]") {
   const Scene scene = load_scene("builtin:generated:3000:6:2");
-  CpuStudyRenderer renderer(scene, AccelOptions{});
+  StudyRenderer renderer(make_cpu_backend(), scene, AccelOptions{});
   const ImageSettings settings = tiny_image();
   const RmseStudy study =
       run_rmse_study(renderer, "generated", parse_structure_list("2l-ls:2:4"), settings, "", 0.1f, quiet);
@@ -161,7 +164,7 @@ TEST_CASE("the policy study's RMSE and rays on X equal a direct computation from
   const Scene scene = load_scene("builtin:cornell");
   AccelOptions options;
   options.ls.min_triangles = 0;
-  CpuStudyRenderer renderer(scene, options);
+  StudyRenderer renderer(make_cpu_backend(), scene, options);
   const ImageSettings settings = tiny_image();
   const StructureSpec x = parse_structure("f-ls:3:6");
   const PolicyStudy study = run_policy_study(renderer, "builtin:cornell", x, {1, 3}, {0.3f, 0.6f}, settings, quiet);

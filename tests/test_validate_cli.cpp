@@ -1,6 +1,6 @@
 // linespace-validate end to end: bad input exits 2 with one line, and each study writes the files and
 // keys DESIGN §9 promises, with figures that must hold by construction.
-#include "run_program.h"
+#include "tests/run_program.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -2,11 +2,15 @@
 // reference kernels: every hit record bit for bit (t, u, v, ids) and the Line Space counters, for
 // closest and any hit, on the built-in scenes and random ones, every structure, both widths (of the
 // treelets and of the order-free tree).
-#include "accel.h"
-#include "exact_wide_bvh.h"
-#include "triangle_blocks.h"
-#include "load_scene.h"
-#include "ray_generators.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/line_space_builder.h"
+#include "cpu/trace/exact_wide_bvh.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/fast_tracer.h"
+#include "cpu/trace/trace_rays.h"
+#include "cpu/trace/triangle_blocks.h"
+#include "scenes/load_scene.h"
 
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>

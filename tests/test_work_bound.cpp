@@ -1,10 +1,12 @@
 // The reference traversal's work split at the Line Space nodes, and `linespace-validate bound` built on
 // it: checked against the exact structures' own counts, against closed forms at D = 0 and D = 1, and
 // against the subtrees derived independently from the triangle ranges.
-#include "accel.h"
-#include "bound_study.h"
-#include "load_scene.h"
-#include "ray_generators.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
+#include "validate/bound_study.h"
 
 #include <catch2/catch.hpp>
 

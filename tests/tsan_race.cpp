@@ -10,7 +10,7 @@
 //
 // In every mode the bodies first wait for each other, with relaxed atomics (which order nothing for
 // TSan), so they surely run at the same time on two threads; if they never meet, exit 1.
-#include "parallel.h"
+#include "common/base/parallel.h"
 
 #include <atomic>
 #include <chrono>

@@ -1,6 +1,9 @@
-#include "bound_study.h"
+#include "validate/bound_study.h"
 
-#include "scene.h"
+#include "common/model/scene.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/trace/trace_rays.h"
 
 #include <chrono>
 #include <filesystem>
@@ -50,7 +53,7 @@ BoundStudy run_bound_study(const Scene& scene, const std::string& scene_name, co
   study.ray_count = rays.size();
   for (const StructureSpec& spec : specs) {
     const auto t0 = std::chrono::steady_clock::now();
-    Accel accel = build_accel(scene, spec, options);
+    Accel accel = build_planned_accel(scene, spec, options);
     BoundRow row;
     row.structure = spec.name();
     row.exact = spec.two_level() ? "2l-bvh" : "bvh";

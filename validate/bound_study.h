@@ -11,8 +11,9 @@
 // image error).  Work is in box tests: boxes + 2.3 x triangles + 5.7 x lookups (cpu/accel.h).
 #pragma once
 
-#include "accel.h"
-#include "table.h"
+#include "common/structure/accel.h"
+#include "cpu/trace/trace_rays.h"
+#include "validate/table.h"
 
 #include <nlohmann/json.hpp>
 

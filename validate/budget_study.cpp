@@ -1,6 +1,7 @@
-#include "budget_study.h"
+#include "validate/budget_study.h"
 
-#include "cli_report.h"
+#include "common/structure/accel.h"
+#include "cpu/app/cli_report.h"
 
 #include <chrono>
 #include <filesystem>

@@ -5,10 +5,11 @@
 // memory (the plan's predicted bytes beside the built structure's), and the pilot's figures.
 #pragma once
 
-#include "ls_budget.h"
-#include "measure.h"
-#include "rmse_study.h"
-#include "table.h"
+#include "common/structure/accel.h"
+#include "cpu/build/ls_budget.h"
+#include "validate/measure.h"
+#include "validate/rmse_study.h"
+#include "validate/table.h"
 
 #include <nlohmann/json.hpp>
 #include <string>

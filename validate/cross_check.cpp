@@ -1,12 +1,16 @@
-#include "cross_check.h"
+#include "validate/cross_check.h"
 
-#include "gpu_accel.h"
-#include "gpu_line_space.h"
-#include "gpu_trace.h"
-#include "load_scene.h"
-#include "memory_budget.h"
-#include "ray_files.h"
-#include "ray_generators.h"
+#include "common/base/memory_budget.h"
+#include "common/base/ray_files.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/trace_rays.h"
+#include "gpu/gpu_accel.h"
+#include "gpu/gpu_line_space.h"
+#include "gpu/gpu_trace.h"
+#include "scenes/load_scene.h"
 
 #include <cstring>
 
@@ -102,14 +106,14 @@ CrossCheckResult compare_hit_arrays(const std::vector<lsk::Hit>& cpu, const std:
 CrossCheckResult cross_check_candidates(const gpu::VulkanContext& context, const Scene& scene, const StructureSpec& spec,
                                         const AccelOptions& options) {
   if (!spec.line_space()) throw InputError("candidates: structure '" + spec.name() + "' has no Line Space (use f-ls:D:N or 2l-ls:D:N)");
-  const Accel cpu = build_accel(scene, spec, options);
+  const Accel cpu = build_planned_accel(scene, spec, options);
   const Accel gpu = gpu::build_accel_gpu(context, scene, spec, options);
   return compare_candidate_arrays(cpu, gpu);
 }
 
 CrossCheckResult cross_check_hits(const gpu::VulkanContext& context, const Scene& scene, const StructureSpec& spec,
                                   const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options) {
-  const Accel accel = build_accel(scene, spec, options);
+  const Accel accel = build_planned_accel(scene, spec, options);
   std::vector<lsk::Hit> cpu(rays.size());
   lsk::LsCounters cpu_counters{}, gpu_counters{};
   trace_rays(accel, rays.data(), cpu.data(), rays.size(), any_hit, &cpu_counters);

@@ -2,8 +2,8 @@
 // and traced hits (ids and the bits of t, u, v), must be identical on both back ends (DESIGN §5).
 #pragma once
 
-#include "accel.h"
-#include "vk_context.h"
+#include "common/structure/accel.h"
+#include "gpu/vk_context.h"
 
 #include <cstdio>
 #include <string>

@@ -1,6 +1,6 @@
-#include "heatmap.h"
+#include "validate/heatmap.h"
 
-#include "scene.h"
+#include "common/model/scene.h"
 
 #include <algorithm>
 #include <array>

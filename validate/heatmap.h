@@ -2,7 +2,7 @@
 // scale so that maps of different structures can be compared, and the three images side by side.
 #pragma once
 
-#include "image_output.h"
+#include "common/render/image_output.h"
 
 #include <string>
 

@@ -1,19 +1,22 @@
 // linespace-validate: measures what the Line Space's approximation costs in image error and buys in
 // speed and memory (DESIGN §7, §9).
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
-#include "bound_study.h"
-#include "budget_study.h"
-#include "cli_flags.h"
-#include "cross_check.h"
-#include "load_scene.h"
-#include "memory_budget.h"
-#include "paper_tables.h"
-#include "policy_study.h"
-#include "ray_files.h"
-#include "ray_generators.h"
-#include "rmse_study.h"
-#include "sweep.h"
-#include "thread_limit.h"
+#include "common/base/memory_budget.h"
+#include "common/base/ray_files.h"
+#include "common/base/thread_limit.h"
+#include "common/structure/accel.h"
+#include "cpu/app/cli_flags.h"
+#include "cpu/build/build_accel.h"
+#include "cpu/trace/ray_generators.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
+#include "validate/bound_study.h"
+#include "validate/budget_study.h"
+#include "validate/cross_check.h"
+#include "validate/paper_tables.h"
+#include "validate/policy_study.h"
+#include "validate/rmse_study.h"
+#include "validate/sweep.h"
 
 #include <CLI/CLI.hpp>
 

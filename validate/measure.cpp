@@ -1,6 +1,7 @@
-#include "measure.h"
+#include "validate/measure.h"
 
-#include "image_metrics.h"
+#include "common/render/image_metrics.h"
+#include "common/render/render_types.h"
 
 namespace ls {
 

@@ -3,8 +3,9 @@
 // the RMSE of each bounce's own contribution shows where the error comes from.
 #pragma once
 
-#include "path_tracer.h"
-#include "study_renderer.h"
+#include "common/render/render_types.h"
+#include "cpu/render/path_tracer.h"
+#include "validate/study_renderer.h"
 
 #include <nlohmann/json.hpp>
 

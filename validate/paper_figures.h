@@ -3,7 +3,7 @@
 // 1024x1024 images.  Absolute speed is not comparable with ours; ratios, RMSE and MB per LS are.
 #pragma once
 
-#include "structure_name.h"
+#include "common/model/structure_name.h"
 
 #include <array>
 #include <string>

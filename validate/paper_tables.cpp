@@ -1,8 +1,9 @@
-#include "paper_tables.h"
+#include "validate/paper_tables.h"
 
-#include "load_scene.h"
-#include "paper_figures.h"
-#include "table.h"
+#include "common/structure/accel.h"
+#include "scenes/load_scene.h"
+#include "validate/paper_figures.h"
+#include "validate/table.h"
 
 #include <algorithm>
 #include <cmath>

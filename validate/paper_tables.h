@@ -4,8 +4,9 @@
 // by which of the paper's claims hold on our scenes.
 #pragma once
 
-#include "measure.h"
-#include "rmse_study.h"
+#include "common/structure/accel.h"
+#include "validate/measure.h"
+#include "validate/rmse_study.h"
 
 #include <set>
 #include <string>

@@ -1,4 +1,6 @@
-#include "policy_study.h"
+#include "validate/policy_study.h"
+
+#include "common/render/render_types.h"
 
 #include <algorithm>
 #include <cmath>

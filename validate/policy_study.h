@@ -12,9 +12,10 @@
 // many times round-robin, so that a change of load falls on all of them alike, and takes the median.
 #pragma once
 
-#include "measure.h"
-#include "rmse_study.h"
-#include "table.h"
+#include "common/render/render_types.h"
+#include "validate/measure.h"
+#include "validate/rmse_study.h"
+#include "validate/table.h"
 
 #include <nlohmann/json.hpp>
 

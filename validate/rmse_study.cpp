@@ -1,6 +1,8 @@
-#include "rmse_study.h"
+#include "validate/rmse_study.h"
 
-#include "heatmap.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "validate/heatmap.h"
 
 #include <chrono>
 #include <cmath>

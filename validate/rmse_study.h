@@ -4,8 +4,8 @@
 // S from bounce 1, beside the reference's in the same run.
 #pragma once
 
-#include "measure.h"
-#include "table.h"
+#include "validate/measure.h"
+#include "validate/table.h"
 
 #include <functional>
 #include <nlohmann/json.hpp>

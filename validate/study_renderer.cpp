@@ -1,36 +1,52 @@
-#include "study_renderer.h"
+#include "validate/study_renderer.h"
 
-#include "bench.h"
-#include "gpu_study_renderer.h"
+#include "common/base/system_info.h"
+#include "common/render/backend.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
+#include "cpu/app/cpu_backend.h"
+#include "gpu/gpu_backend.h"
 
 #include <set>
+#include <utility>
 
 namespace ls {
 
-std::string CpuStudyRenderer::device() const { return "cpu: " + cpu_model(); }
+StudyRenderer::StudyRenderer(std::unique_ptr<Backend> backend, const Scene& scene, const AccelOptions& options)
+    : backend_(std::move(backend)), scene_(scene), options_(options) {}
 
-const Accel& CpuStudyRenderer::structure(const StructureSpec& spec) {
+std::string StudyRenderer::device() const {
+  const std::string device = backend_->device();
+  return device.empty() ? "cpu: " + cpu_model() : "gpu: " + device;
+}
+
+const Accel& StudyRenderer::structure(const StructureSpec& spec) {
   auto it = built_.find(spec.name());
-  if (it == built_.end()) it = built_.emplace(spec.name(), build_accel(scene_, spec, options_)).first;
+  if (it == built_.end()) it = built_.emplace(spec.name(), backend_->build(scene_, spec, options_)).first;
   return it->second;
 }
 
-RenderResult CpuStudyRenderer::render(const RenderOptions& options) {
+RenderResult StudyRenderer::render(const RenderOptions& options) {
   for (const StructureSpec& spec : render_structures(options)) structure(spec);  // the switch's too
-  return ls::render(scene_, built_, options);
+  return backend_->render(scene_, built_, options, {});
 }
 
-void CpuStudyRenderer::set_ls_options(const LsOptions& options) {
+void StudyRenderer::set_ls_options(const LsOptions& options) {
   options_.ls = options;
   for (auto it = built_.begin(); it != built_.end();)
     it = it->second.spec.line_space() ? built_.erase(it) : std::next(it);
 }
 
+std::unique_ptr<StudyRenderer> make_cpu_study_renderer(const Scene& scene, const AccelOptions& options) {
+  return std::make_unique<StudyRenderer>(make_cpu_backend(), scene, options);
+}
+
 std::unique_ptr<StudyRenderer> make_study_renderer(const std::string& device, const Scene& scene,
                                                    const AccelOptions& options) {
-  if (device == "cpu") return std::make_unique<CpuStudyRenderer>(scene, options);
-  if (device == "gpu") return std::make_unique<GpuStudyRenderer>(scene, options, "");
-  if (device.rfind("gpu:", 0) == 0) return std::make_unique<GpuStudyRenderer>(scene, options, device.substr(4));
+  if (device == "cpu") return make_cpu_study_renderer(scene, options);
+  if (device == "gpu") return std::make_unique<StudyRenderer>(gpu::make_gpu_backend(""), scene, options);
+  if (device.rfind("gpu:", 0) == 0)
+    return std::make_unique<StudyRenderer>(gpu::make_gpu_backend(device.substr(4)), scene, options);
   throw InputError("--device " + device + ": expected cpu, gpu or gpu:NAME|INDEX");
 }
 

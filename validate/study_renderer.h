@@ -1,12 +1,14 @@
 // What every study of the validator needs from a back end: the structures it builds (and their
-// memory), and renders with a per-bounce schedule.  Structures are built once and reused by every
+// memory), and renders with a per-bounce schedule.  One caching adaptor over a Backend
+// (common/render/backend.h), the CPU's or the GPU's: structures are built once and reused by every
 // render that names them, so a table of many schedules costs one build per structure.
 #pragma once
 
-#include "accel.h"
-#include "path_tracer.h"
-#include "scene.h"
-#include "structure_name.h"
+#include "common/model/scene.h"
+#include "common/model/structure_name.h"
+#include "common/render/backend.h"
+#include "common/render/render_types.h"
+#include "common/structure/accel.h"
 
 #include <map>
 #include <memory>
@@ -16,33 +18,27 @@ namespace ls {
 
 class StudyRenderer {
  public:
-  virtual ~StudyRenderer() = default;
-  virtual std::string device() const = 0;
+  StudyRenderer(std::unique_ptr<Backend> backend, const Scene& scene, const AccelOptions& options);
+  // "cpu: MODEL" or "gpu: DEVICE".
+  std::string device() const;
   // Builds the structure unless it is built already; throws InputError when refused (memory budget).
-  virtual const Accel& structure(const StructureSpec& spec) = 0;
+  const Accel& structure(const StructureSpec& spec);
   // Renders; every structure of the schedule is built first if needed.
-  virtual RenderResult render(const RenderOptions& options) = 0;
+  RenderResult render(const RenderOptions& options);
   // Frees a structure no later render needs (sweeps over many Line Spaces).
-  virtual void release(const StructureSpec& spec) = 0;
+  void release(const StructureSpec& spec) { built_.erase(spec.name()); }
   // New Line Space options (a sweep over the refusal angle): built Line Spaces are dropped.
-  virtual void set_ls_options(const LsOptions& options) = 0;
-};
-
-// The CPU reference renderer (cpu/path_tracer).
-class CpuStudyRenderer : public StudyRenderer {
- public:
-  CpuStudyRenderer(const Scene& scene, const AccelOptions& options) : scene_(scene), options_(options) {}
-  std::string device() const override;
-  const Accel& structure(const StructureSpec& spec) override;
-  RenderResult render(const RenderOptions& options) override;
-  void release(const StructureSpec& spec) override { built_.erase(spec.name()); }
-  void set_ls_options(const LsOptions& options) override;
+  void set_ls_options(const LsOptions& options);
 
  private:
+  std::unique_ptr<Backend> backend_;
   const Scene& scene_;
   AccelOptions options_;
   std::map<std::string, Accel> built_;
 };
+
+// The CPU back end's study renderer.
+std::unique_ptr<StudyRenderer> make_cpu_study_renderer(const Scene& scene, const AccelOptions& options);
 
 // "cpu", "gpu" (the preferred Vulkan device) or "gpu:NAME|INDEX"; throws InputError for anything else
 // or when there is no such Vulkan device.

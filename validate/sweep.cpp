@@ -1,4 +1,6 @@
-#include "sweep.h"
+#include "validate/sweep.h"
+
+#include "common/structure/accel.h"
 
 #include <cmath>
 #include <filesystem>

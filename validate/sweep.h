@@ -4,9 +4,10 @@
 // data is written first (CSV, JSON); the plot is a separate step (plot_tradeoff.py).
 #pragma once
 
-#include "measure.h"
-#include "rmse_study.h"
-#include "table.h"
+#include "common/structure/accel.h"
+#include "validate/measure.h"
+#include "validate/rmse_study.h"
+#include "validate/table.h"
 
 #include <nlohmann/json.hpp>
 #include <string>

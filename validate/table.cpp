@@ -1,4 +1,5 @@
-#include "table.h"
+#include "validate/table.h"
+
 
 #include <cmath>
 #include <cstdio>

@@ -2,7 +2,8 @@
 // a binary .glb, anything else as .gltf JSON, so one corpus covers both containers.  A loader may
 // refuse the input (InputError); anything else escaping, and every sanitizer report, is a bug.  What
 // loads is also posed (rigid animation) at a few times of each of its first animations.
-#include "load_scene.h"
+#include "common/model/animation.h"
+#include "scenes/load_scene.h"
 
 #include <cstddef>
 #include <cstdint>

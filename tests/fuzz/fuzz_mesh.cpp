@@ -1,7 +1,7 @@
 // libFuzzer harness: the OBJ/OFF/PLY/STL readers from bytes.  The first byte picks the format
 // (its value mod 4: 0 OBJ, 1 OFF, 2 PLY, 3 STL; the seed files start with the digits '0'..'3'),
 // the rest is the file.  Refusal (InputError) is fine; anything else is a bug.
-#include "load_scene.h"
+#include "scenes/load_scene.h"
 
 #include <cstddef>
 #include <cstdint>

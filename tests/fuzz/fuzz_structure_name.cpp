@@ -1,8 +1,7 @@
 // libFuzzer harness: structure names, structure lists and schedules (common/structure_name).
 // Whatever parses must print a canonical name that parses back to the same structures.
-#include "structure_name.h"
-
-#include "scene.h"
+#include "common/model/scene.h"
+#include "common/model/structure_name.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -1,0 +1,67 @@
+#include "common/structure/accel.h"
+
+
+#include <cmath>
+
+namespace ls {
+
+Traversal parse_traversal(const std::string& text) {
+  if (text == "reference") return Traversal::Reference;
+  if (text == "fast") return Traversal::Fast;
+  throw InputError("traversal '" + text + "' is not reference or fast");
+}
+
+const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" : "reference"; }
+
+std::vector<ObjectLs> LsPlan::objects(size_t meshes) const {
+  std::vector<ObjectLs> objects(meshes);
+  for (const LsPlanRow& r : rows) objects[r.mesh] = r.chosen;
+  return objects;
+}
+
+size_t Accel::bytes_ls() const {
+  return node_ls.size() * sizeof(uint32_t) + ls_nodes.size() * sizeof(lsk::LsNode) +
+         ls_candidates.size() * sizeof(uint32_t) + tri_normals.size() * sizeof(glm::uvec4);
+}
+
+
+size_t Accel::bytes_total() const {
+  return nodes.size() * sizeof(lsk::BvhNode) + tris.size() * sizeof(lsk::Triangle) +
+         tri_ids.size() * sizeof(uint32_t) + tri_instances.size() * sizeof(uint32_t) +
+         top_nodes.size() * sizeof(lsk::BvhNode) + instances.size() * sizeof(lsk::InstanceRecord) + bytes_ls();
+}
+
+lsk::TraceContext Accel::context() const {
+  lsk::TraceContext c;
+  c.nodes = nodes.data();
+  c.tris = tris.data();
+  c.tri_ids = tri_ids.data();
+  c.tri_instances = tri_instances.data();
+  c.top_nodes = top_nodes.data();
+  c.instances = instances.data();
+  if (spec.line_space() && !node_ls.empty()) {  // laid out (a 2l-ls:auto plan traces before it has one)
+    c.node_ls = node_ls.data();
+    c.ls_nodes = ls_nodes.data();
+    c.ls_candidates = ls_candidates.data();
+    c.tri_normals = tri_normals.data();
+    c.ls_enabled = 1;
+    const double a = double(ls_options.angle_degrees) * 3.14159265358979323846 / 180.0;
+    c.ls_cos2 = ls_options.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
+    c.ls_reverse = ls_options.reverse_behind ? 1u : 0u;
+  }
+  return c;
+}
+
+
+void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from) {
+  into.lookups += from.lookups;
+  into.empty += from.empty;
+  into.accepted += from.accepted;
+  into.refused_angle += from.refused_angle;
+  into.refused_behind += from.refused_behind;
+  into.refused_beyond += from.refused_beyond;
+  into.refused_parallel += from.refused_parallel;
+  into.refused_no_shaft += from.refused_no_shaft;
+}
+
+}  // namespace ls

@@ -1,0 +1,173 @@
+// A structure's data, apart from what builds and traces it: the flat BVH (F-BVH) over world-space
+// triangles or the two-level BVH (2L-BVH: one BVH per unique mesh in object space plus a top level
+// over instances), their Line Space, and the options they are built with.  The arrays are the std430
+// buffers the GPU port uploads unchanged.  Builders (cpu/build) include this header, never the
+// reverse; the CPU's fast path (cpu/trace/fast_tracer.h) hangs off an Accel as an opaque pointer.
+#pragma once
+
+#include "common/kernels/layouts.h"
+#include "common/model/scene.h"
+#include "common/model/structure_name.h"
+#include "common/structure/trace_context.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ls {
+
+class FastTracer;
+
+// Which traversal trace_rays uses.
+enum class Traversal { Reference, Fast };
+
+Traversal parse_traversal(const std::string& text);  // "reference" or "fast"; throws InputError
+const char* traversal_name(Traversal t);
+
+struct BvhBuildOptions {
+  int bins = 32;                 // SAH bins per axis
+  int max_leaf_size = 4;         // a leaf never holds more, unless primitives cannot be separated
+  float traversal_cost = 1.0f;   // relative to one primitive test
+  int sah_depth_limit = 32;      // deeper, split at the object median: total depth stays < 64
+};
+
+// The Line Space of one object of a two-level structure: integration depth D and subdivision N
+// (n = 0: no Line Space; the object is traced exactly).
+struct ObjectLs {
+  int depth = 0;
+  int n = 0;
+  bool operator==(const ObjectLs&) const = default;
+};
+
+struct LsOptions {
+  // Defaults chosen by measurement: see README, "Line Space parameters".
+  int further_rays = 0;          // search rays after the midpoint ray
+  float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
+  bool reverse_behind = false;   // --ls-behind reverse: a plane hit behind the origin asks the reverse shaft (ls_lookup.h)
+  uint32_t min_triangles = 8;    // subtrees with fewer triangles get no LS (0: the paper's behaviour)
+  bool paper_candidates = false; // 4-byte candidates instead of the compact 1/2/4-byte local index
+  size_t max_memory = 0;         // refuse above this estimate (0: half of physical memory)
+  // Per mesh (2L only): each object's own D and N, overriding the structure's; empty: the
+  // structure's D and N for every object.  2l-ls:auto fills it from the budget (ls_budget.h).
+  std::vector<ObjectLs> objects;
+  // 2l-ls:auto (ls_budget.h): bytes of Line Space to spend (bytes_ls), and the pilot's rays.
+  size_t budget = 0;
+  size_t budget_rays = 1u << 15;
+  // Called now and then from the building threads with (LS nodes done, LS nodes): a progress bar.
+  std::function<void(size_t done, size_t total)> progress;
+};
+
+struct LsBuildInfo {
+  size_t ls_nodes = 0;
+  size_t shafts_per_ls = 0;          // 30 N^4 when every LS node has the same N, else 0
+  size_t shafts = 0;                 // over all LS nodes
+  size_t empty_shafts = 0;
+  size_t candidate_bytes = 0;        // as stored
+  size_t candidate_bytes_paper = 0;  // at 4 bytes per shaft
+  size_t candidate_bytes_compact = 0;
+  double seconds = 0.0;
+};
+
+// 2l-ls:auto's plan (cpu/build/ls_budget.h): which objects get a Line Space, with which D and N.
+struct LsPlanRow {
+  uint32_t mesh = 0;
+  std::string name;
+  size_t triangles = 0;
+  size_t instances = 0;
+  size_t hits = 0;         // pilot rays whose exact hit lies on this object
+  size_t relevant = 0;     // pilot rays that cross one of its instance boxes (the only ones it can change)
+  ObjectLs chosen;         // n = 0: none
+  ObjectLs reference;      // what the reference uniform structure gives it
+  size_t bytes = 0;        // its LS nodes and candidates
+  double error = 0.0;      // alone on the pilot: fraction of all pilot rays it gets wrong with `chosen`
+  double saved_work = 0.0; // alone on the pilot: work saved per pilot ray with `chosen`
+  std::string reason;      // "chosen", "no gain", "not reached", "too small"
+};
+
+// A structure's figures on the pilot, every object's Line Space at once.
+struct PilotFigures {
+  size_t bytes_ls = 0;
+  double error = 0.0;       // fraction of pilot rays whose answer moved
+  double saved_work = 0.0;  // per pilot ray, against the exact 2L-BVH
+};
+
+struct LsPlan {
+  size_t budget = 0;           // bytes of Line Space allowed (bytes_ls)
+  size_t fixed_bytes = 0;      // bytes_ls without any LS node: per-node index, per-triangle normals
+  size_t predicted_bytes = 0;  // fixed + every row's bytes: the structure's bytes_ls, exactly
+  std::string reference;       // the uniform structure the plan must be as fast as ("" when none fits)
+  bool reference_chosen = false;  // the optimiser did not beat the reference: the plan is the reference
+  double lambda = 0.0;         // the work constraint's multiplier
+  PilotFigures plan, uniform;  // joint pilot evaluations of the plan and of the reference
+  size_t pilot_rays = 0;         // diffuse (closest hit)
+  size_t pilot_shadow_rays = 0;  // to the lights (any hit)
+  size_t evaluations = 0;      // (object, D, N) options evaluated
+  size_t shafts_searched = 0;
+  double seconds = 0.0;
+  std::vector<LsPlanRow> rows;  // every object the structure holds, by mesh index
+
+  std::vector<ObjectLs> objects(size_t meshes) const;  // LsOptions::objects of the plan
+};
+
+struct Accel {
+  StructureSpec spec;
+  std::vector<lsk::BvhNode> nodes;          // F: the flat BVH; 2L: every object BVH, one after another
+  std::vector<lsk::Triangle> tris;          // in BVH order
+  std::vector<uint32_t> tri_ids;            // triangle id within its mesh
+  std::vector<uint32_t> tri_instances;      // F only: instance id per triangle
+  std::vector<lsk::BvhNode> top_nodes;      // 2L only
+  std::vector<lsk::InstanceRecord> instances;  // 2L only, in top-level order
+  std::vector<uint32_t> object_roots;       // 2L only: root node of each unique mesh's BVH (by mesh index;
+                                            // LS_INVALID for meshes no instance uses)
+  size_t objects = 0;                       // unique meshes the structure holds
+  size_t instance_count = 0;
+  size_t world_triangles = 0;
+  int max_depth = 0;                        // deepest BVH (object BVHs for 2L)
+  double build_seconds = 0.0;               // everything, Line Space included
+  BvhBuildOptions bvh_options;              // what the BVHs were built with (the top level is rebuilt with it)
+  // Which build this is (unique per build_accel call in a process; 0 for hand-made structures) and
+  // how often its top level was updated since (top_level_update.h): device copies check both.
+  uint64_t build_id = 0;
+  uint32_t top_level_version = 0;
+
+  // Line Space (F-LS, 2L-LS): see line_space_builder.h and common/kernels/ls_lookup.h.
+  std::vector<uint32_t> node_ls;            // per BVH node: its LsNode, or LS_INVALID
+  std::vector<lsk::LsNode> ls_nodes;
+  std::vector<uint32_t> ls_candidates;      // packed per LsNode
+  std::vector<glm::uvec4> tri_normals;      // octahedral vertex normals per triangle (BVH order)
+  LsOptions ls_options;
+  LsBuildInfo ls_info;
+  std::shared_ptr<const LsPlan> ls_plan;    // 2l-ls:auto: the per-object choice (ls_budget.h)
+
+  // The fast CPU path (cpu/trace/fast_tracer.h): the wide BVH over the arrays above, and which path trace_rays
+  // takes by default.  Both give the same answers; the reference is the GPU's twin.
+  std::shared_ptr<const FastTracer> fast;
+  Traversal traversal = Traversal::Fast;
+  double wide_build_seconds = 0.0;          // part of build_seconds
+
+  size_t bytes_total() const;
+  size_t fast_bytes = 0;                    // FastTracer::bytes() of `fast`, set wherever it is made
+  size_t bytes_wide() const { return fast_bytes; }  // the fast path's wide nodes (beside bytes_total)
+  size_t bytes_ls() const;
+  lsk::TraceContext context() const;
+};
+
+struct AccelOptions {
+  BvhBuildOptions bvh;
+  LsOptions ls;
+  bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
+  Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
+  int wide_width = 4;                     // treelets (Line Space structures): 4 or 8, chosen by measurement
+  int exact_width = 8;                    // the order-free walk's nodes: 4 or 8, chosen by measurement
+  bool fast_path = true;  // false: no fast path is made, trace_rays takes the reference (the GPU port's builds)
+  AccelOptions() = default;
+  AccelOptions(const BvhBuildOptions& b) : bvh(b) {}  // NOLINT: implicit on purpose
+};
+
+// Sums Line Space lookup counters.
+void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from);
+
+}  // namespace ls

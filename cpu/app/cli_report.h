@@ -1,0 +1,24 @@
+// What `build` and `trace` print, shared by linespace-cpu and linespace-gpu (DESIGN §9: the same keys
+// from both programs).  The flags they share are in cli_flags.h.
+#pragma once
+
+#include "common/structure/accel.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace ls {
+
+// Prints what `build` reports (DESIGN §9 keys); `device`, when given, names who built the candidates.
+void print_build(const Accel& a, bool json, const std::string& device = "");
+
+// A 2l-ls:auto plan (ls_budget.h): as JSON (the `ls_plan` key of build --json), and as a table.
+nlohmann::json ls_plan_json(const LsPlan& plan);
+void print_ls_plan(const LsPlan& plan);
+
+// Line Space lookup counters, one line on stderr.
+void print_counters(const lsk::LsCounters& c);
+
+}  // namespace ls

@@ -1,0 +1,98 @@
+// linespace-profile: traces a ray file with one structure on one thread, for profilers.
+//
+// It exists beside linespace-cpu because callgrind cannot run that one here: linespace-cpu links
+// OpenImageIO, which loads libhwy, whose start-up code executes an instruction valgrind 3.19 does
+// not know (SIGILL) on these machines.  This program is linked with --as-needed and references no
+// image code, so none of that is loaded.  Instruction counts of the traversal alone:
+//   valgrind --tool=callgrind --toggle-collect='ls::trace_rays*' linespace-profile SCENE STRUCTURE RAYS
+// Timing: the best of --repeat runs, in ns per ray (one thread; compare binaries, not machines).
+#include "common/base/ray_files.h"
+#include "common/structure/accel.h"
+#include "cpu/build/build_structures.h"
+#include "cpu/trace/embree_tracer.h"
+#include "cpu/trace/trace_rays.h"
+#include "scenes/load_scene.h"
+
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace {
+
+int usage() {
+  std::fprintf(stderr,
+               "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
+               "--occlusion] [--ls-min-triangles M] [--ls-behind exact|reverse] [--embree-isa ISA] [--exact-width 4|8]\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  if (argc < 4) return usage();
+  int repeat = 1;
+  enum class Path { Fast, Reference, Embree } path = Path::Fast;
+  enum class Query { Closest, AnyHit, Occlusion } query = Query::Closest;
+  ls::AccelOptions options;
+  std::string embree_isa = "best";  // valgrind 3.19 has no AVX-512: under it, "best" is Embree's avx2
+  for (int i = 4; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--repeat" && i + 1 < argc) repeat = std::atoi(argv[++i]);
+    else if (a == "--reference") path = Path::Reference;
+    else if (a == "--embree") path = Path::Embree;
+    else if (a == "--any-hit") query = Query::AnyHit;
+    else if (a == "--occlusion") query = Query::Occlusion;
+    else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
+    else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
+    else if (a == "--ls-behind" && i + 1 < argc && (std::string(argv[i + 1]) == "exact" || std::string(argv[i + 1]) == "reverse"))
+      options.ls.reverse_behind = std::string(argv[++i]) == "reverse";
+    else if (a == "--exact-width" && i + 1 < argc) options.exact_width = std::atoi(argv[++i]);  // 4 or 8, else InputError
+    else return usage();
+  }
+  if (repeat < 1) return usage();
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const ls::Scene scene = ls::load_scene(argv[1]);
+  const std::vector<lsk::Ray> rays = ls::read_rays(argv[3]);
+  std::vector<lsk::Hit> hits(rays.size());
+  std::function<void()> run;
+  ls::Accel accel;
+  std::unique_ptr<ls::EmbreeTracer> embree;
+  const bool any_hit = query != Query::Closest;
+  if (path == Path::Embree) {
+    embree = std::make_unique<ls::EmbreeTracer>(scene, embree_isa);
+    run = [&] { embree->trace(rays.data(), hits.data(), rays.size(), any_hit); };
+  } else {
+    accel = ls::build_planned_accel(scene, ls::parse_structure(argv[2]), options);
+    const ls::Traversal traversal = path == Path::Fast ? ls::Traversal::Fast : ls::Traversal::Reference;
+    if (query == Query::Occlusion)
+      run = [&] { ls::trace_occlusion(accel, rays.data(), hits.data(), rays.size(), nullptr, traversal); };
+    else
+      run = [&] { ls::trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal); };
+  }
+  double best = 0.0;
+  for (int r = 0; r < repeat; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    run();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (r == 0 || s < best) best = s;
+  }
+  size_t blocked = 0;
+  for (const lsk::Hit& h : hits) blocked += h.triangle != lsk::LS_INVALID;
+  std::printf("%s, %s path: %.1f ns per ray (best of %d, one thread), %zu of %zu rays hit\n",
+              path == Path::Embree ? ("embree (" + embree->isa() + ")").c_str() : argv[2],
+              path == Path::Fast ? "fast" : path == Path::Reference ? "reference" : "Embree's", best / double(rays.size()) * 1e9,
+              repeat, blocked, rays.size());
+  return 0;
+} catch (const ls::InputError& e) {
+  std::fprintf(stderr, "linespace-profile: %s\n", e.what());
+  return 2;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "linespace-profile: %s\n", e.what());
+  return 1;
+}

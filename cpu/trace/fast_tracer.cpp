@@ -1,0 +1,677 @@
+#include "cpu/trace/fast_tracer.h"
+
+#include "common/structure/accel.h"
+#include "cpu/trace/exact_wide_bvh.h"
+#include "cpu/trace/simd.h"
+#include "cpu/trace/reference_trace.h"
+#include "cpu/trace/triangle_blocks.h"
+#include "cpu/trace/wide_bvh.h"
+
+#include <bit>
+#include <cmath>
+#include <cstddef>
+#include <type_traits>
+
+namespace ls {
+
+// The batch the box tests run in: 8 floats with AVX (LINESPACE_ISA=avx2 or native), else 4 (SSE2,
+// the portable x86-64 default; NEON on aarch64).  AVX-512's 16 floats would be wider than an 8-wide
+// node or a 4-wide treelet's 6 boxes, so 8 is the most taken.
+#if XSIMD_WITH_AVX
+using SimdArch = xsimd::avx;
+#else
+using SimdArch = Simd4Arch;
+#endif
+using FloatBatch = xsimd::batch<float, SimdArch>;
+
+std::string fast_path_isa() {
+  return std::string(SimdArch::name()) + " (" + std::to_string(FloatBatch::size) + " floats)";
+}
+
+namespace {
+
+using lsk::Hit;
+using lsk::LS_INVALID;
+using lsk::uint;
+using lsk::vec3;
+
+// Rays the order-free walk takes: finite origin, direction and tmin (its slab arithmetic is the
+// reference's only there; anything else follows the reference's order in the treelets).
+LS_ALWAYS_INLINE bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
+  return std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z) && std::isfinite(dir.x) &&
+         std::isfinite(dir.y) && std::isfinite(dir.z) && !std::isnan(tmin);
+}
+
+// The per-ray constants of the SIMD box tests (lsk::ray_box on a node's lanes), broadcast once into
+// batches of Batch floats, for nodes that keep per axis a row of lower and a row of upper bounds.
+template <class Batch>
+struct SlabRay {
+  Batch origin[3];
+  Batch inv_dir[3];
+  uint32_t lo[3];     // byte offset in the node of each axis' lower and upper rows
+  uint32_t hi[3];
+  uint32_t enter[3];  // the row the ray enters each slab through (lo where inv_dir >= 0), and leaves
+  uint32_t leave[3];
+  bool parallel[3];   // safe_reciprocal's huge value: the ray runs parallel to that slab
+  bool any_parallel;
+  bool by_sign;       // entry and exit taken from enter/leave (a finite ray), else as min and max
+};
+
+template <class Batch, class Node>
+LS_ALWAYS_INLINE void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const vec3& inv_dir, bool finite) {
+  constexpr float big = 3.0e38f;
+  constexpr uint32_t row = uint32_t(sizeof(Node::lo[0]));
+  const float o[3] = {origin.x, origin.y, origin.z};  // indexed in memory, not through glm's switch
+  const float inv[3] = {inv_dir.x, inv_dir.y, inv_dir.z};
+  for (int a = 0; a < 3; ++a) {
+    r.origin[a] = Batch(o[a]);
+    r.inv_dir[a] = Batch(inv[a]);
+    r.lo[a] = uint32_t(offsetof(Node, lo)) + row * uint32_t(a);
+    r.hi[a] = uint32_t(offsetof(Node, hi)) + row * uint32_t(a);
+    const bool ascending = inv[a] >= 0.0f;
+    r.enter[a] = ascending ? r.lo[a] : r.hi[a];
+    r.leave[a] = ascending ? r.hi[a] : r.lo[a];
+    r.parallel[a] = std::abs(inv[a]) == big;
+  }
+  r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
+  r.by_sign = finite;
+}
+
+template <class Batch, class Node>
+SlabRay<Batch> make_slab_ray(const vec3& origin, const vec3& inv_dir, bool finite) {
+  SlabRay<Batch> r;
+  init_slab_ray<Batch, Node>(r, origin, inv_dir, finite);
+  return r;
+}
+
+// lsk::ray_box on the lanes of a node whose rows start at `rows` (the node, plus the byte offset of
+// the first lane of the batch): the entry distance and the widened exit distance; a lane is hit
+// when near <= widened.  The scalar kernel's operations (slab_interval, widen_distance) lane by lane,
+// without fused multiply-adds (-ffp-contract=off).  For a finite ray each slab's entry and exit come
+// from the planes its direction says, not as min and max of the two: the same values (rounding is
+// monotone), up to the sign of a zero, which no comparison sees.
+template <bool kBySign, bool kParallel, class Batch>
+LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
+                                 Batch& widened) {
+  constexpr float big = 3.0e38f;
+  auto row = [&](uint32_t offset) { return Batch::load_aligned(reinterpret_cast<const float*>(rows + offset)); };
+  Batch tn[3];
+  Batch tf[3];
+  for (int a = 0; a < 3; ++a) {
+    if (kParallel && r.parallel[a]) {
+      const auto inside = (r.origin[a] >= row(r.lo[a])) && (r.origin[a] <= row(r.hi[a]));
+      tn[a] = xsimd::select(inside, Batch(-big), Batch(big));
+      tf[a] = xsimd::select(inside, Batch(big), Batch(-big));
+    } else if (kBySign) {
+      tn[a] = (row(r.enter[a]) - r.origin[a]) * r.inv_dir[a];
+      tf[a] = (row(r.leave[a]) - r.origin[a]) * r.inv_dir[a];
+    } else {
+      const Batch t0 = (row(r.lo[a]) - r.origin[a]) * r.inv_dir[a];
+      const Batch t1 = (row(r.hi[a]) - r.origin[a]) * r.inv_dir[a];
+      tn[a] = glm_min(t0, t1);
+      tf[a] = glm_max(t0, t1);
+    }
+  }
+  near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], tmin));
+  const Batch far = glm_min(glm_min(tf[0], tf[1]), glm_min(tf[2], tmax));
+  widened = far + (far & xsimd::bitwise_cast<Batch>(xsimd::batch<int32_t, typename Batch::arch_type>(0x7FFFFFFF))) *
+                       Batch(lsk::LS_WIDEN_SLACK);
+}
+
+// slab_tests with its per-ray choices made once per call: a ray parallel to no slab (nearly all)
+// runs straight-line code.
+template <bool kBySign, class Batch>
+LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
+                                 Batch& widened) {
+  if (r.any_parallel)
+    slab_tests<kBySign, true>(rows, r, tmin, tmax, near, widened);
+  else
+    slab_tests<kBySign, false>(rows, r, tmin, tmax, near, widened);
+}
+
+// The box tests of every lane of a treelet: entry distances and widened exit distances.
+template <int K>
+LS_ALWAYS_INLINE void box_tests(const WideNode<K>& node, const SlabRay<FloatBatch>& r, const FloatBatch& tmin, float tmax, float* tnear,
+                      float* tfar) {
+  const FloatBatch tmax_batch(tmax);
+  for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
+    FloatBatch near;
+    FloatBatch widened;
+    const char* rows = reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c);
+    if (r.by_sign)
+      slab_tests<true>(rows, r, tmin, tmax_batch, near, widened);
+    else
+      slab_tests<false>(rows, r, tmin, tmax_batch, near, widened);
+    near.store_aligned(tnear + c);
+    widened.store_aligned(tfar + c);
+  }
+}
+
+// lsk::widen_distance with |t| taken by clearing the sign bit: glm's abs (t >= 0 ? t : -t) is a
+// branch, which a walk's pops mispredicted about once a ray.  The two differ only in the sign of a
+// zero or a NaN, which no comparison sees.
+LS_ALWAYS_INLINE float widen_limit(float t) { return t + std::fabs(t) * lsk::LS_WIDEN_SLACK; }
+
+// What a node visit asks of the traversal.
+enum class Visit { Descend, Skip, Stop };
+
+// The reference's loop (trace_bvh / trace_two_level), node for node, on a wide tree.  Starts at the
+// treelet root of wide node w (its box already tested by the caller).  visit(ls, leaf, first, count,
+// block, entry) is called for every node the reference visits (entry: an inner node's order-free
+// entry, exact_wide_bvh.h): an inner node (leaf = false) is descended only on Visit::Descend;
+// Visit::Stop ends the walk and returns true.
+//
+// Each wide node's boxes are tested once, when the walk enters it, against the current t = h0; later
+// decisions at its inner positions (after a pop, with a smaller current t = h) reuse them.  This is
+// exact: the reference tests tnear <= widen(min(tf, h)), tnear does not depend on t, and widen is
+// monotone, so for h <= h0 that is tnear <= widen(min(tf, h0)) && tnear <= widen(h).  (A NaN tmax is
+// ignored by the reference's min and never changes: the second test is then skipped.)  The walk is
+// depth first, so a node's results sit in the slot of its wide depth until every pending position of
+// it has been popped.
+template <int K, class VisitFn>
+inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray, float tmin, const Hit& hit, VisitFn&& visit) {
+  const FloatBatch tmin_batch(tmin);
+  using Node = WideNode<K>;
+  constexpr int kMaxDepth = lsk::TraceContext::LS_STACK_SIZE / K + 1;
+  alignas(64) float tnear[kMaxDepth][Node::kPadded];
+  alignas(64) float tfar[kMaxDepth][Node::kPadded];
+  const bool nan_t = hit.t != hit.t;
+  uint stack_w[lsk::TraceContext::LS_STACK_SIZE];
+  uint stack_pos[lsk::TraceContext::LS_STACK_SIZE];
+  int stack_depth[lsk::TraceContext::LS_STACK_SIZE];
+  float stack_t[lsk::TraceContext::LS_STACK_SIZE];
+  int sp = 0;
+  uint pos = 1;
+  int depth = 0;
+  while (true) {
+    const Node& node = tree.nodes[w];
+    const bool root = pos == 1;
+    const uint lane = pos - 2;
+    const bool leaf = !root && node.count[lane] > 0;
+    const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u,
+                          leaf ? node.tri_lane[lane] : LS_INVALID, root ? node.root_exact : node.exact[lane]);
+    if (v == Visit::Stop) return true;
+    if (v == Visit::Descend && !leaf) {
+      if (root) {
+        box_tests(node, ray, tmin_batch, hit.t, tnear[depth], tfar[depth]);
+      }
+      const float* tn = tnear[depth];
+      const float* tf = tfar[depth];
+      const float limit = widen_limit(hit.t);
+      const uint c0 = 2u * pos;
+      const uint c1 = c0 + 1u;
+      const float tn0 = tn[c0 - 2u];
+      const float tn1 = tn[c1 - 2u];
+      const bool hit0 = tn0 <= tf[c0 - 2u] && (nan_t || tn0 <= limit);
+      const bool hit1 = tn1 <= tf[c1 - 2u] && (nan_t || tn1 <= limit);
+      // A bottom-level inner node continues as the root of its own wide node, one wide level down.
+      auto go = [&](uint c, uint& to_w, uint& to_pos, int& to_depth) {
+        if (c >= Node::kBottom && node.count[c - 2u] == 0u) {
+          to_w = node.first[c - 2u];
+          to_pos = 1u;
+          to_depth = depth + 1;
+        } else {
+          to_w = w;
+          to_pos = c;
+          to_depth = depth;
+        }
+      };
+      if (hit0 && hit1) {
+        const bool first0 = tn0 <= tn1;
+        go(first0 ? c1 : c0, stack_w[sp], stack_pos[sp], stack_depth[sp]);
+        stack_t[sp] = first0 ? tn1 : tn0;
+        ++sp;
+        go(first0 ? c0 : c1, w, pos, depth);
+        continue;
+      }
+      if (hit0 || hit1) {
+        go(hit0 ? c0 : c1, w, pos, depth);
+        continue;
+      }
+    }
+    // Pop the nearest pending node that can still hold something closer than the current hit.
+    bool found = false;
+    const float limit = widen_limit(hit.t);
+    while (sp > 0 && !found) {
+      --sp;
+      if (stack_t[sp] <= limit) {
+        w = stack_w[sp];
+        pos = stack_pos[sp];
+        depth = stack_depth[sp];
+        found = true;
+      }
+    }
+    if (!found) return false;
+  }
+}
+
+// The batch an exact W-wide node's boxes are tested in: 4 floats, or 8 where the build has AVX and
+// W = 8 (an 8-wide node on SSE2 takes two batches).
+template <int W>
+using ExactBatch = std::conditional_t<W == 8, FloatBatch, Float4>;
+template <int W>
+using ExactBoxRay = SlabRay<ExactBatch<W>>;
+
+// ray_box on the children of an exact wide node against [tmin, tmax]: the lanes hit (bit l) and
+// their entry distances.  An unused lane's box is NaN, which no ray enters: its entry distance is
+// NaN on an axis the ray crosses (glm_max keeps a NaN first operand) and +big on one it runs along.
+template <bool kParallel, int W>
+LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode<W>& node, const ExactBoxRay<W>& r, const ExactBatch<W>& tmin,
+                                          float tmax, float* tnear) {
+  using Batch = ExactBatch<W>;
+  unsigned bits = 0;
+  const Batch tmax_batch(tmax);
+  for (int c = 0; c < W; c += int(Batch::size)) {
+    Batch near;
+    Batch widened;
+    slab_tests<true, kParallel>(reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c), r, tmin, tmax_batch, near,
+                                widened);
+    near.store_aligned(tnear + c);
+    bits |= lane_bits(near <= widened) << c;
+  }
+  return bits;
+}
+
+// The order-free closest-hit walk below an exact wide node (whose binary node's box the caller has
+// tested): nearest child first, a pending child popped only while its entry distance can still hold
+// something as close as the current hit, as in the reference.
+template <int W>
+struct ExactWalk {
+  struct Pending {
+    uint child;
+    uint count;
+    float t;
+  };
+  static constexpr int kStack = W * lsk::TraceContext::LS_STACK_SIZE;  // < W more per wide level
+  uint child = 0;  // what the next step visits: a wide node (count 0) or a leaf
+  uint count = 0;
+  int sp = 0;
+  Pending stack[kStack];
+
+  void start(uint entry) {
+    child = entry;
+    count = 0;
+    sp = 0;
+  }
+
+  // The nearest pending child that can still hold something as close as a hit at t; false: none.
+  bool pop(float t) {
+    const float limit = widen_limit(t);
+    while (sp > 0) {
+      --sp;
+      if (stack[sp].t <= limit) {
+        child = stack[sp].child;
+        count = stack[sp].count;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // Visits the next wide node or leaf; leaf(child, count) tests a leaf's primitives against the
+  // running hit and returns true to end the walk there (an occlusion query's first hit).  When the
+  // boxes admit several children, all of them start loading at once.  False when the walk is over.
+  template <bool kParallel, class LeafFn, class PrefetchFn>
+  LS_ALWAYS_INLINE bool step(const ExactWideTree<W>& tree, const ExactBoxRay<W>& ray, const ExactBatch<W>& tmin, const Hit& hit,
+                             LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
+    if (count != 0u) {
+      if (leaf(child, count)) return false;  // the query stops at this leaf
+      return pop(hit.t);
+    }
+    const ExactWideNode<W>& node = tree.nodes[child];
+    alignas(32) float tn[W];
+    unsigned lanes = exact_box_tests<kParallel>(node, ray, tmin, hit.t, tn);
+    if (lanes == 0u) return pop(hit.t);
+    unsigned near = unsigned(std::countr_zero(lanes));
+    lanes &= lanes - 1u;
+    if (lanes == 0u) {  // one child: go on with it
+      child = node.child[near];
+      count = node.count[near];
+      return true;
+    }
+    auto push = [&](unsigned l) {
+      stack[sp++] = Pending{node.child[l], node.count[l], tn[l]};
+      if (node.count[l] == 0u) {
+        const char* p = reinterpret_cast<const char*>(&tree.nodes[node.child[l]]);
+        for (size_t line = 0; line < sizeof(ExactWideNode<W>); line += 64) __builtin_prefetch(p + line);
+      } else {
+        prefetch_leaf(node.child[l]);
+      }
+    };
+    unsigned other = unsigned(std::countr_zero(lanes));
+    lanes &= lanes - 1u;
+    if (tn[other] < tn[near]) std::swap(near, other);
+    if (lanes == 0u) {  // two: push the farther, go on with the nearer
+      push(other);
+    } else {  // three or more: push them farthest first, go on with the nearest
+      unsigned order[W] = {near, other};
+      unsigned n = 2;
+      for (; lanes != 0u; lanes &= lanes - 1u) {
+        unsigned l = unsigned(std::countr_zero(lanes));
+        unsigned j = n++;
+        while (j > 0u && tn[order[j - 1u]] > tn[l]) {
+          order[j] = order[j - 1u];
+          --j;
+        }
+        order[j] = l;
+      }
+      for (unsigned k = n - 1u; k > 0u; --k) push(order[k]);
+      near = order[0];
+    }
+    child = node.child[near];
+    count = node.count[near];
+    return true;
+  }
+};
+
+// One ray's whole order-free walk below `entry`.
+template <int W, class LeafFn, class PrefetchFn>
+LS_ALWAYS_INLINE void walk_exact(const ExactWideTree<W>& tree, uint entry, const ExactBoxRay<W>& ray, float tmin, const Hit& hit,
+                       LeafFn&& leaf, PrefetchFn&& prefetch_leaf) {
+  if (hit.t != hit.t) return;  // a NaN tmax: no t is <= it, the reference finds nothing either
+  const ExactBatch<W> tmin_batch(tmin);
+  ExactWalk<W> walk;
+  walk.start(entry);
+  if (ray.any_parallel)  // rays parallel to a slab are rare: the others run straight-line box tests
+    while (walk.template step<true>(tree, ray, tmin_batch, hit, leaf, prefetch_leaf)) {
+    }
+  else
+    while (walk.template step<false>(tree, ray, tmin_batch, hit, leaf, prefetch_leaf)) {
+    }
+}
+
+// What the fast path keeps of the object level: the treelets and the exact wide tree of the object
+// BVHs (or of the flat BVH) and the triangle blocks.  Shared by the tracers of every top level
+// (animation).
+template <int K, int W>
+struct ObjectPart {
+  TriangleBlocks blocks;
+  ExactWideTree<W> exact;
+  WideTree<K> tree;
+};
+
+// K: the treelets' binary levels (4 or 8 wide); W: the exact wide tree's width (4 or 8).
+template <int K, int W>
+class WideTracer final : public FastTracer {
+ public:
+  // Only Line Space structures get treelets (their lookups need the reference's order).  An exact
+  // structure answers everything order-free but the reference's any hit (trace --any-hit), which
+  // its reference kernels answer; shadow rays are occlusion queries (occluded()).
+  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()), ordered_(accel.spec.line_space()) {
+    const std::vector<uint32_t> none;
+    const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
+    auto part = std::make_shared<ObjectPart<K, W>>();
+    const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
+    part->exact = build_exact_wide_tree<W>(accel.nodes, node_ls, roots);
+    part->blocks = build_triangle_blocks(accel.nodes, accel.tris, part->exact);
+    if (ordered_) part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.lane_of, part->exact.entry_of);
+    if (two_level_) build_top(accel);
+    part_ = std::move(part);
+    blocks_ = part_->blocks.blocks.data();
+  }
+
+  // The object part of `other`, new wide top trees over accel.top_nodes.
+  WideTracer(const WideTracer& other, const Accel& accel)
+      : two_level_(other.two_level_), ordered_(other.ordered_), part_(other.part_), blocks_(other.blocks_) {
+    build_top(accel);
+  }
+
+  std::shared_ptr<const FastTracer> with_top_level(const Accel& accel) const override {
+    if (!two_level_) return std::make_shared<WideTracer>(*this);
+    return std::make_shared<WideTracer>(*this, accel);
+  }
+  const void* object_part() const override { return part_.get(); }
+
+  void trace(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, bool any_hit) const override {
+    trace_all(c, rays, hits, count, any_hit ? Query::AnyHit : Query::Closest);
+  }
+
+  void occluded(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count) const override {
+    // With a Line Space the ordered walk stays: which lookups run before the first hit is in the
+    // counters, and those must be the reference's.
+    trace_all(c, rays, hits, count, c.ls_enabled != 0u ? Query::AnyHit : Query::Occlusion);
+  }
+
+  void find_candidates(lsk::TraceContext& c, const lsk::LsNode& ls, const vec3* centres, uint32_t first, uint32_t end,
+                       uint32_t further_rays, uint32_t instance, uint32_t* prims) const override {
+    // The shafts in index order: start patch s / (5 N^2), end patch its rank among the patches off
+    // the start face (lsk::ls_shaft_patches), stepped on without dividing.
+    const uint nn = ls.n * ls.n;
+    uint start_patch, first_end_patch;
+    lsk::ls_shaft_patches(first, ls.n, start_patch, first_end_patch);
+    uint end_rank = first - start_patch * 5u * nn;
+    uint start_face_first = (start_patch / nn) * nn;  // the start face's first patch
+    for (uint32_t s = first; s != end; ++s) {
+      const uint end_patch_s = end_rank >= start_face_first ? end_rank + nn : end_rank;
+      uint prim = LS_INVALID;
+      vec3 a = centres[start_patch];
+      vec3 d;
+      if (c.ls_segment(a, centres[end_patch_s], d)) {  // search ray 0 joins the patch centres
+        Hit hit = c.ls_search_hit();
+        trace_bvh<true>(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+      }
+      for (uint k = 1u; k <= further_rays && prim == LS_INVALID; ++k) {
+        if (!c.ls_search_segment(ls, s, k, a, d)) continue;
+        Hit hit = c.ls_search_hit();
+        trace_bvh<true>(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+      }
+      prims[s - first] = prim;
+      if (++end_rank == 5u * nn) {
+        end_rank = 0u;
+        if (++start_patch % nn == 0u) start_face_first += nn;
+      }
+    }
+  }
+
+  size_t bytes() const override {
+    return part_->tree.bytes() + part_->exact.bytes() + part_->blocks.bytes() + top_.bytes() + top_exact_.bytes();
+  }
+  int width() const override { return 1 << K; }
+  int exact_width() const override { return W; }
+
+ private:
+  // The top level: the exact wide tree, whose leaf lanes hold their first instance, and for Line
+  // Space structures the treelets.
+  void build_top(const Accel& accel) {
+    top_exact_ = build_exact_wide_tree<W>(accel.top_nodes, {}, {0u}, ExactLeaves::Instances);
+    if (ordered_) top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
+  }
+
+  // What a trace asks: the closest hit, the reference's any hit (the first in its order), or only
+  // whether anything is hit (some hit, found in any order: the fast path's shadow rays).
+  enum class Query { Closest, AnyHit, Occlusion };
+
+  void trace_all(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query q) const {
+    for (size_t i = 0; i < count; ++i) {
+      const lsk::Ray& ray = rays[i];
+      // A flat structure's trace_bvh makes this choice itself; the top walk of a two-level one does not.
+      if (two_level_ && !ordered_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
+        hits[i] = trace_ray_reference(c, ray, true, q != Query::Closest);
+      else
+        hits[i] = two_level_ ? trace_two_level(c, ray, q) : trace_flat(c, ray, q);
+    }
+  }
+
+  // The ray's BlockRay, made when first asked: many rays that enter an instance's box never reach
+  // a triangle of it.
+  struct LazyBlockRay {
+    const vec3& origin;
+    const vec3& dir;
+    BlockRay made;  // not zeroed first: that cost 40 instructions a ray
+    bool ready = false;
+    LazyBlockRay(const vec3& o, const vec3& d) : origin(o), dir(d) {}
+    LS_ALWAYS_INLINE const BlockRay& operator()() {
+      if (!ready) {
+        make_block_ray(origin, dir, made);
+        ready = true;
+      }
+      return made;
+    }
+  };
+
+  // The order-free walk below `entry`, leaves tested against tri_ray().  True: an occlusion query's
+  // hit (any_hit is one here: the reference's any hit never walks order-free).
+  LS_ALWAYS_INLINE bool run_exact(lsk::TraceContext& c, uint entry, const ExactBoxRay<W>& exact_ray, LazyBlockRay& tri_ray,
+                                  float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
+    bool stopped = false;
+    auto run = [&](auto&& ray_for_leaf) LS_ALWAYS_LAMBDA {
+      walk_exact(
+          part_->exact, entry, exact_ray, tmin, hit,
+          [&](uint lane, uint n) {
+            return stopped = trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, any_hit, hit, hit_prim);
+          },
+          [&](uint lane) { prefetch_block(lane / 4u); });
+    };
+    if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
+      const BlockRay& tr = tri_ray();
+      run([&]() -> const BlockRay& { return tr; });
+    } else {  // an instance's object: many walks end before any leaf
+      run(tri_ray);
+    }
+    return stopped;
+  }
+
+  // A query that is one order-free walk from the entry at the root (the entry's node tests the
+  // root's children, which pass only where the root would): an exact structure's, or an instance's
+  // object without a Line Space at its root.  Kept apart from the treelet walk's closures, whose
+  // stores cost about 20 instructions a ray before any box is tested.
+  LS_ALWAYS_INLINE bool trace_entry(lsk::TraceContext& c, uint entry, const vec3& origin, const vec3& dir, const vec3& inv_dir,
+                                    float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
+    ExactBoxRay<W> exact_ray;
+    init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);
+    LazyBlockRay tri_ray{origin, dir};
+    return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
+  }
+
+  // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
+  // the order-free walk below the entries it reaches, except for the reference's any hit.  Returns
+  // true when an any-hit or occlusion query found its hit (the caller stops).  Always inlined: GCC
+  // otherwise chose by a hair whether an instance's walk sat in the top walk or behind a call
+  // (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change elsewhere).  kSearch:
+  // the LS build's search gets its own copy of the walks it inlines; sharing them added a caller
+  // to the instance's exact walk, which GCC then left out of line (2l-bvh on generated 3,388 ->
+  // 3,483).
+  template <bool kSearch = false>
+  LS_ALWAYS_INLINE bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin,
+                                  uint instance, Query q, bool use_ls, Hit& hit, uint& hit_prim) const {
+    const bool any_hit = q != Query::Closest;
+    const bool order_free = q != Query::AnyHit && order_free_ray(origin, dir, tmin);
+    if (!order_free && !ordered_)  // no treelets: the reference kernel (e.g. an object ray that overflowed)
+      return trace_bvh_reference(c, root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
+    const vec3 inv_dir = lsk::safe_reciprocal(dir);
+    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
+    const uint root_entry = part_->exact.entry_of[root];
+    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID)
+      return trace_entry(c, root_entry, origin, dir, inv_dir, tmin, instance, any_hit, hit, hit_prim);
+    LazyBlockRay tri_ray{origin, dir};
+    ExactBoxRay<W> exact_ray;  // made once, at the first order-free walk
+    bool exact_ray_made = false;
+    auto exact = [&](uint entry) LS_ALWAYS_LAMBDA {  // true: an occlusion query's hit
+      if (!exact_ray_made) {
+        init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);  // in place: no copy
+        exact_ray_made = true;
+      }
+      return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
+    };
+    // A call from the treelet walk: inlined there it outgrew GCC's budget (f-ls:8:6 on cornell
+    // 2,818 -> 3,045 instructions a ray).
+    auto exact_call = [&](uint entry) __attribute__((noinline)) { return exact(entry); };
+    float t_root;
+    if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
+    auto visit = [&](uint ls, bool leaf, uint, uint count, uint tri_lane, uint entry) {
+      if (use_ls && ls != LS_INVALID) {
+        const uint answer = c.ls_lookup(ls, origin, dir, inv_dir, tmin, instance, hit, hit_prim);
+        if (answer == lsk::TraceContext::LS_ACCEPTED && any_hit) return Visit::Stop;
+        if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
+      }
+      if (leaf)
+        return trace_blocks(c, blocks_, tri_lane, count, tri_ray(), tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
+                                                                                                        : Visit::Skip;
+      if (!order_free || entry == LS_INVALID) return Visit::Descend;
+      return exact_call(entry) ? Visit::Stop : Visit::Skip;
+    };
+    const lsk::BvhNode& node = c.nodes[root];
+    if (node.count > 0)  // a root that is a leaf has no wide node
+      return visit(root_ls, true, node.first, node.count, part_->blocks.lane_of[root], LS_INVALID) == Visit::Stop;
+    if (order_free && root_entry != LS_INVALID)  // a Line Space at the root, then the whole tree order-free
+      return visit(root_ls, false, 0u, 0u, LS_INVALID, root_entry) == Visit::Stop;
+    // Out of line: inlined here, the treelet walk crowded the flat structure's own (f-ls:8:6 on
+    // fireplace 3,727 -> 4,107 instructions a ray, when the triangle blocks grew by block_distances).
+    return [&]() __attribute__((noinline)) {
+      return walk(part_->tree, part_->tree.wide_of[root],
+                  make_slab_ray<FloatBatch, WideNode<K>>(origin, inv_dir, order_free_ray(origin, dir, tmin)), tmin, hit, visit);
+    }();
+  }
+
+  Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, Query q) const {
+    Hit hit = lsk::empty_hit(ray);
+    uint prim = LS_INVALID;
+    trace_bvh(c, 0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, q, c.ls_enabled != 0u, hit, prim);
+    return lsk::finish_hit(hit);
+  }
+
+  Hit trace_two_level(lsk::TraceContext& c, const lsk::Ray& ray, Query q) const {
+    Hit hit = lsk::empty_hit(ray);
+    uint prim = LS_INVALID;
+    const vec3 inv_dir = lsk::safe_reciprocal(ray.dir);
+    float t_root;
+    if (!lsk::ray_box(ray.origin, inv_dir, ray.tmin, hit.t, c.top_nodes[0].lo, c.top_nodes[0].hi, t_root))
+      return lsk::finish_hit(hit);
+    const bool use_ls = c.ls_enabled != 0u;
+    auto instances = [&](uint first, uint count) {  // true: the query stops
+      for (uint i = first; i < first + count; ++i) {
+        const lsk::InstanceRecord& rec = c.instances[i];
+        vec3 o;
+        vec3 d;
+        c.instance_ray(rec, ray.origin, ray.dir, o, d);
+        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, q, use_ls, hit, prim)) return true;
+      }
+      return false;
+    };
+    const lsk::BvhNode& root = c.top_nodes[0];
+    if (root.count > 0)
+      instances(root.first, root.count);
+    else if (q != Query::AnyHit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no decision depends on the order
+      [&]() __attribute__((noinline)) {  // its own function, with the instances' walks inlined in it (fewer spills)
+        walk_exact(top_exact_, top_exact_.entry_of[0],
+                   make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir, true), ray.tmin, hit, instances,
+                   [](uint) {});
+      }();
+    else
+      walk(top_, top_.wide_of[0],
+           make_slab_ray<FloatBatch, WideNode<K>>(ray.origin, inv_dir, order_free_ray(ray.origin, ray.dir, ray.tmin)),
+           ray.tmin, hit,
+           [&](uint, bool leaf, uint first, uint count, uint, uint) {
+             if (!leaf) return Visit::Descend;
+             return instances(first, count) ? Visit::Stop : Visit::Skip;
+           });
+    return lsk::finish_hit(hit);
+  }
+
+  void prefetch_block(uint block) const {
+    const char* p = reinterpret_cast<const char*>(&blocks_[block]);
+    for (size_t line = 0; line < sizeof(TriBlock); line += 64) __builtin_prefetch(p + line);
+  }
+
+  bool two_level_;
+  bool ordered_;  // a Line Space structure: treelets for the reference's order
+  std::shared_ptr<const ObjectPart<K, W>> part_;
+  const TriBlock* blocks_ = nullptr;  // part_->blocks.blocks.data(): one load less on the hot path
+  WideTree<K> top_;
+  ExactWideTree<W> top_exact_;
+};
+
+}  // namespace
+
+std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width, int exact_width) {
+  if (width != 4 && width != 8) throw InputError("wide BVH width must be 4 or 8, not " + std::to_string(width));
+  if (exact_width != 4 && exact_width != 8)
+    throw InputError("exact wide BVH width must be 4 or 8, not " + std::to_string(exact_width));
+  if (width == 8)
+    return exact_width == 8 ? std::shared_ptr<const FastTracer>(std::make_shared<WideTracer<3, 8>>(accel))
+                            : std::make_shared<WideTracer<3, 4>>(accel);
+  return exact_width == 8 ? std::shared_ptr<const FastTracer>(std::make_shared<WideTracer<2, 8>>(accel))
+                          : std::make_shared<WideTracer<2, 4>>(accel);
+}
+
+}  // namespace ls
