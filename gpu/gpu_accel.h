@@ -3,7 +3,6 @@
 #pragma once
 
 #include "common/structure/accel.h"
-#include "gpu/shader_params.h"
 #include "gpu/vk_buffer.h"
 
 #include <vector>
@@ -22,12 +21,12 @@ class GpuAccel {
   // object nodes, triangles and Line Space on the device are not touched.
   void upload_top_level(const Accel& accel);
   // The parameters of lsk::TraceContext for this structure (ls_enabled, ls_cos2, two_level).
-  ShaderParams params() const { return params_; }
+  lsk::ShaderParams params() const { return params_; }
 
  private:
   const VulkanContext* context_;
   Buffer nodes_, tris_, tri_ids_, tri_instances_, top_nodes_, instances_, node_ls_, ls_nodes_, ls_candidates_, tri_normals_;
-  ShaderParams params_;
+  lsk::ShaderParams params_{};
 };
 
 }  // namespace ls::gpu

@@ -23,9 +23,9 @@ void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearch
   size_t empty = 0;
   if (ls_count > 0) {
     GpuAccel gpu(context, accel);  // the candidates are not read by the search
-    ComputePipeline pipeline(context, spirv_ls_candidates(), 11, sizeof(ShaderParams));
+    ComputePipeline pipeline(context, spirv_ls_candidates(), 11, sizeof(lsk::ShaderParams));
     KernelTimer timer(context);
-    ShaderParams params = gpu.params();
+    lsk::ShaderParams params = gpu.params();
     params.ls_enabled = 0;
     params.further_rays = uint32_t(accel.ls_options.further_rays);
     params.search_instance = ls_search_instance(accel);

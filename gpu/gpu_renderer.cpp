@@ -19,25 +19,9 @@ namespace {
 
 constexpr uint32_t kGroup = 64;  // local_size_x of shade.comp
 
-// The push constants of shaders/shade.comp (same order).
-struct ShadePush {
-  uint32_t mode = 0;
-  uint32_t sample_index = 0;
-  uint32_t bounce = 0;
-  uint32_t count = 0;
-  uint32_t image_offset = 0;
-  uint32_t list_kind = 0;         // mode 3: 0 extension rays (decide), 1 shadow rays (as decided)
-  float switch_threshold = 0.0f;  // mode 3: the throughput switch's T
-  uint32_t pad = 0;
-};
-static_assert(sizeof(ShadePush) == 32, "must match the GLSL push-constant block");
-
-// Binding 6 of shade.comp.
-struct ShadeConstants {
-  lsk::ShadeParams shade;
-  lsk::CameraFrame cam;
-};
-static_assert(sizeof(ShadeConstants) == 112, "must match the GLSL buffer Constants");
+// shade.comp's push constants and constants buffer (common/kernels/layouts.h).
+using lsk::ShadeConstants;
+using lsk::ShadePush;
 
 // A list of rays with the pixel each belongs to, and their hits.
 struct RayList {
@@ -167,7 +151,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     }
     const uint32_t zero[2] = {0, 0};
     counts.upload(zero, sizeof(zero));
-    ShadePush split;
+    ShadePush split{};
     split.mode = 3;
     split.count = count;
     split.list_kind = any_hit ? 1u : 0u;
@@ -182,7 +166,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
 
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces, like the CPU renderer
-    ShadePush push;
+    ShadePush push{};
     push.sample_index = uint32_t(s);
     push.mode = 0;
     push.count = uint32_t(order.size());

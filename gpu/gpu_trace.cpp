@@ -11,7 +11,7 @@ constexpr uint32_t kMaxGroups = 65535;    // the minimum maxComputeWorkGroupCoun
 }  // namespace
 
 GpuTracer::GpuTracer(const VulkanContext& context)
-    : context_(context), pipeline_(context, spirv_trace(), 13, sizeof(ShaderParams)), timer_(context),
+    : context_(context), pipeline_(context, spirv_trace(), 13, sizeof(lsk::ShaderParams)), timer_(context),
       counters_(context, sizeof(lsk::LsCounters)) {}
 
 void GpuTracer::set_rays(const std::vector<lsk::Ray>& rays) {
@@ -37,7 +37,7 @@ void GpuTracer::trace_buffers(const GpuAccel& accel, const Buffer& rays, const B
   pipeline_.bind(bindings);
   const lsk::LsCounters zero{};
   counters_.upload(&zero, sizeof(zero));
-  ShaderParams params = accel.params();
+  lsk::ShaderParams params = accel.params();
   params.any_hit = any_hit ? 1u : 0u;
   params.count = count;
   const auto start = std::chrono::steady_clock::now();

@@ -1,6 +1,8 @@
 // std430 structures shared by host and shaders, declared once (DESIGN §4).  Each has the same size
 // and member offsets in C++ (glm::vec3 = 12 bytes, 4-aligned) and in GLSL std430 (vec3 16-aligned):
-// a vec3 is always followed by a 4-byte scalar so both layouts agree; cpu/layouts_check.cpp asserts it.
+// a vec3 is always followed by a 4-byte scalar so both layouts agree.  The static_asserts at the end
+// hold the C++ side to the std430 sizes and offsets, and tests/test_layouts.cpp compares every struct
+// with the offsets glslang gives it in SPIR-V.
 #ifndef LS_LAYOUTS_H
 #define LS_LAYOUTS_H
 
@@ -199,6 +201,41 @@ struct PathState {
   uint switched;
   uint pad1;
   uint pad2;
+};
+
+// The push constants of trace.comp and ls_candidates.comp (gpu/shaders/scene_buffers.glsl declares
+// the block's one member `pc` of this type).
+struct ShaderParams {
+  uint ls_enabled;       // trace: use the Line Space
+  uint ls_n;             // candidates: N of this dispatch's LS nodes (the result stride)
+  float ls_cos2;         // cos^2 of the refusal angle (negative: refuse all)
+  uint two_level;        // trace: 2L structure
+  uint any_hit;          // trace: stop at the first hit
+  uint first;            // trace: first ray of this dispatch
+  uint count;            // trace: rays in the buffer
+  uint ls_reverse;       // trace: --ls-behind reverse (ls_lookup.h)
+  uint further_rays;     // candidates: search rays after the midpoint ray
+  uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
+  uint first_ls;         // candidates: first LS node of this dispatch
+  uint ls_count;         // candidates: LS nodes in this dispatch
+};
+
+// The push constants of shade.comp (its block's one member `pc`).
+struct ShadePush {
+  uint mode;
+  uint sample_index;
+  uint bounce;
+  uint count;               // batch entries: pixels to start (mode 0), hits to shade (modes 1, 2)
+  uint image_offset;        // first float of this bounce's image
+  uint list_kind;           // mode 3: 0 extension rays (decide), 1 shadow rays (as decided)
+  float switch_threshold;   // mode 3: the throughput switch's T
+  uint pad0;
+};
+
+// Binding 6 of shade.comp: what every invocation of a render reads.
+struct ShadeConstants {
+  ShadeParams shade;
+  CameraFrame cam;
 };
 
 #ifdef __cplusplus

@@ -1,6 +1,7 @@
-// The scene's buffers, named like the pointer members of lsk::TraceContext (cpu/trace_context.h) so
-// that the single-source kernels read them unchanged, plus the parameters every kernel receives.
-// Mirrored on the host by gpu/shader_params.h (ShaderParams) and gpu/gpu_accel.cpp (binding order).
+// The scene's buffers, named like the pointer members of lsk::TraceContext
+// (common/structure/trace_context.h) so that the single-source kernels read them unchanged, plus the
+// parameters every kernel receives (lsk::ShaderParams, common/kernels/layouts.h).  The host binds them
+// in this order (gpu/gpu_accel.cpp).
 #include "kernels/hit.h"
 #include "kernels/layouts.h"
 #include "kernels/line_space.h"
@@ -18,20 +19,7 @@ layout(std430, binding = 7) readonly buffer LsNodes { LsNode ls_nodes[]; };
 layout(std430, binding = 8) readonly buffer LsCandidates { uint ls_candidates[]; };
 layout(std430, binding = 9) readonly buffer TriNormals { uvec4 tri_normals[]; };
 
-layout(push_constant) uniform Params {
-  uint ls_enabled;       // trace: use the Line Space
-  uint ls_n;             // candidates: N of this dispatch's LS nodes (the result stride)
-  float ls_cos2;         // cos^2 of the refusal angle (negative: refuse all)
-  uint two_level;        // trace: 2L structure
-  uint any_hit;          // trace: stop at the first hit
-  uint first;            // trace: first ray of this dispatch
-  uint count;            // trace: rays in the buffer
-  uint ls_reverse;       // trace: --ls-behind reverse (ls_lookup.h)
-  uint further_rays;     // candidates: search rays after the midpoint ray
-  uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
-  uint first_ls;         // candidates: first LS node of this dispatch
-  uint ls_count;         // candidates: LS nodes in this dispatch
-} pc;
+layout(push_constant) uniform Params { ShaderParams pc; };  // common/kernels/layouts.h
 
 uint ls_enabled = pc.ls_enabled;
 float ls_cos2 = pc.ls_cos2;

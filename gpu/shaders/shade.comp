@@ -21,7 +21,9 @@ layout(std430, binding = 2) readonly buffer ShadeTriangles { ShadeTriangle shade
 layout(std430, binding = 3) readonly buffer Materials { ShadeMaterial materials[]; };
 layout(std430, binding = 4) readonly buffer Lights { ShadeLight lights[]; };
 layout(std430, binding = 5) readonly buffer LightCdf { float light_cdf[]; };
-layout(std430, binding = 6) readonly buffer Constants { ShadeParams shade; CameraFrame cam; };
+layout(std430, binding = 6) readonly buffer Constants { ShadeConstants constants; };
+ShadeParams shade = constants.shade;  // the name the kernels read (ShadeContext::shade on the CPU)
+CameraFrame cam = constants.cam;
 layout(std430, binding = 7) buffer Paths { PathState paths[]; };
 layout(std430, binding = 8) buffer Images { float images[]; };       // (bounces + 1) x pixels x RGB, sums
 layout(std430, binding = 9) buffer Dropped { uint dropped[]; };      // per pixel
@@ -33,16 +35,7 @@ layout(std430, binding = 14) writeonly buffer ShadowRays { Ray shadow_rays[]; };
 layout(std430, binding = 15) writeonly buffer ShadowPixels { uint shadow_pixels[]; };
 layout(std430, binding = 16) buffer Counts { uint next_count; uint shadow_count; };
 
-layout(push_constant) uniform ShadePush {
-  uint mode;
-  uint sample_index;
-  uint bounce;
-  uint count;         // batch entries: pixels to start (mode 0), hits to shade (modes 1, 2)
-  uint image_offset;  // first float of this bounce's image
-  uint list_kind;     // mode 3: 0 extension rays, 1 shadow rays
-  float switch_threshold;
-  uint pad0;
-} pc;
+layout(push_constant) uniform Push { ShadePush pc; };  // common/kernels/layouts.h
 
 #include "kernels/shade_path.h"
 #include "kernels/throughput_switch.h"
