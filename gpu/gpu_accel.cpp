@@ -16,10 +16,7 @@ GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
       ls_nodes_(make_buffer(context, accel.ls_nodes, "ls_nodes")),
       ls_candidates_(make_buffer(context, accel.ls_candidates, "ls_candidates")),
       tri_normals_(make_buffer(context, accel.tri_normals, "tri_normals")) {
-  const lsk::TraceContext c = accel.context();  // the CPU's parameters, so both sides agree
-  params_.ls_enabled = c.ls_enabled;
-  params_.ls_cos2 = c.ls_cos2;
-  params_.ls_reverse = c.ls_reverse;
+  params_.ls_enabled = trace_context(accel).ls_enabled;  // the CPU's rule, so both sides agree
   params_.two_level = accel.spec.two_level() ? 1u : 0u;
 }
 
@@ -41,6 +38,13 @@ void GpuAccel::upload_top_level(const Accel& accel) {
   };
   refresh(top_nodes_, accel.top_nodes, "top_nodes");
   refresh(instances_, accel.instances, "instances");
+}
+
+lsk::ShaderParams GpuAccel::params(const LsLookup& lookup) const {
+  lsk::ShaderParams p = params_;
+  p.ls_cos2 = ls_cos2(lookup);  // the CPU's arithmetic, so both sides agree
+  p.ls_reverse = lookup.reverse_behind ? 1u : 0u;
+  return p;
 }
 
 }  // namespace ls::gpu

@@ -21,7 +21,8 @@ class GpuAccel {
   // object nodes, triangles and Line Space on the device are not touched.
   void upload_top_level(const Accel& accel);
   // The parameters of lsk::TraceContext for this structure (ls_enabled, ls_cos2, two_level).
-  lsk::ShaderParams params() const { return params_; }
+  // The push constants of a trace with `lookup` (structure and Line Space parameters).
+  lsk::ShaderParams params(const LsLookup& lookup) const;
 
  private:
   const VulkanContext* context_;

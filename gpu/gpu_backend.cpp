@@ -46,13 +46,13 @@ class GpuBackend : public Backend {
                   timing.kernel_seconds, timing.kernel_seconds > 0.0 ? shafts / timing.kernel_seconds : 0.0, device_.c_str());
     }
   }
-  std::vector<lsk::Hit> trace(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, lsk::LsCounters* counters,
-                              std::string* timing_text) override {
+  std::vector<lsk::Hit> trace(const Accel& accel, const LsLookup& lookup, const std::vector<lsk::Ray>& rays, bool any_hit,
+                              lsk::LsCounters* counters, std::string* timing_text) override {
     GpuAccel uploaded(context_, accel);
     GpuTracer tracer(context_);
     tracer.set_rays(rays);
     GpuTraceTiming timing;
-    std::vector<lsk::Hit> hits = tracer.trace(uploaded, any_hit, counters, &timing);
+    std::vector<lsk::Hit> hits = tracer.trace(uploaded, lookup, any_hit, counters, &timing);
     if (timing_text) *timing_text = " in " + std::to_string(timing.kernel_seconds) + " s (kernel)";
     return hits;
   }
@@ -79,7 +79,8 @@ class GpuBackend : public Backend {
   }
   // MRays/s from the median kernel time (timestamps; wall time where the queue has none).
   void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs, int repeats,
-             const AccelOptions& options, bool any_hit, const std::string& /*embree_isa: no Embree here*/, bool json) override {
+             const AccelOptions& options, const LsLookup& lookup, bool any_hit, const std::string& /*embree_isa: no Embree here*/,
+             bool json) override {
     struct Entry {
       std::string structure;
       double mrays_per_s = 0.0;
@@ -92,11 +93,11 @@ class GpuBackend : public Backend {
     for (const StructureSpec& spec : specs) {
       const Accel accel = build_accel_gpu(context_, scene, spec, options);
       GpuAccel uploaded(context_, accel);
-      tracer.trace(uploaded, any_hit);  // the first dispatch compiles the pipeline on some drivers
+      tracer.trace(uploaded, lookup, any_hit);  // the first dispatch compiles the pipeline on some drivers
       std::vector<double> seconds;
       for (int r = 0; r < repeats; ++r) {
         GpuTraceTiming t;
-        tracer.trace(uploaded, any_hit, nullptr, &t);
+        tracer.trace(uploaded, lookup, any_hit, nullptr, &t);
         seconds.push_back(t.kernel_seconds > 0.0 ? t.kernel_seconds : t.wall_seconds);
       }
       results.push_back({spec.name(), double(rays.size()) / median(seconds) * 1e-6, accel.bytes_total(), accel.build_seconds});

@@ -25,7 +25,7 @@ void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearch
     GpuAccel gpu(context, accel);  // the candidates are not read by the search
     ComputePipeline pipeline(context, spirv_ls_candidates(), 11, sizeof(lsk::ShaderParams));
     KernelTimer timer(context);
-    lsk::ShaderParams params = gpu.params();
+    lsk::ShaderParams params = gpu.params(LsLookup{});  // the search asks no Line Space
     params.ls_enabled = 0;
     params.further_rays = uint32_t(accel.ls_options.further_rays);
     params.search_instance = ls_search_instance(accel);

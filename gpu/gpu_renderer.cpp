@@ -109,7 +109,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     if (count == 0) return;
     BounceStats& stats = result.bounces[size_t(k)];
     GpuTraceTiming timing;
-    tracer.trace_buffers(*accel[size_t(k)], list.rays, list.hits, count, any_hit, line_space[size_t(k)] ? &stats.ls : nullptr,
+    tracer.trace_buffers(*accel[size_t(k)], options.lookup, list.rays, list.hits, count, any_hit, line_space[size_t(k)] ? &stats.ls : nullptr,
                          &timing);
     stats.trace_seconds += timing.kernel_seconds > 0.0 ? timing.kernel_seconds : timing.wall_seconds;
   };
@@ -129,7 +129,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
     BounceStats& stats = result.bounces[size_t(k)];
     GpuTraceTiming timing;
     lsk::LsCounters counters{};
-    tracer.trace_buffers(*switch_accel, list.rays, list.hits, count, any_hit, policy.structure.line_space() ? &counters : nullptr,
+    tracer.trace_buffers(*switch_accel, options.lookup, list.rays, list.hits, count, any_hit, policy.structure.line_space() ? &counters : nullptr,
                          &timing);
     const double seconds = timing.kernel_seconds > 0.0 ? timing.kernel_seconds : timing.wall_seconds;
     stats.trace_seconds += seconds;

@@ -21,14 +21,15 @@ void GpuTracer::set_rays(const std::vector<lsk::Ray>& rays) {
   count_ = uint32_t(rays.size());
 }
 
-std::vector<lsk::Hit> GpuTracer::trace(const GpuAccel& accel, bool any_hit, lsk::LsCounters* counters, GpuTraceTiming* timing) {
-  trace_buffers(accel, rays_, hits_, count_, any_hit, counters, timing);
+std::vector<lsk::Hit> GpuTracer::trace(const GpuAccel& accel, const LsLookup& lookup, bool any_hit, lsk::LsCounters* counters,
+                                        GpuTraceTiming* timing) {
+  trace_buffers(accel, lookup, rays_, hits_, count_, any_hit, counters, timing);
   std::vector<lsk::Hit> hits(count_);
   if (count_) hits_.download(hits.data(), hits.size() * sizeof(lsk::Hit));
   return hits;
 }
 
-void GpuTracer::trace_buffers(const GpuAccel& accel, const Buffer& rays, const Buffer& hits, uint32_t count, bool any_hit,
+void GpuTracer::trace_buffers(const GpuAccel& accel, const LsLookup& lookup, const Buffer& rays, const Buffer& hits, uint32_t count, bool any_hit,
                               lsk::LsCounters* counters, GpuTraceTiming* timing) {
   std::vector<const Buffer*> bindings = accel.bindings();
   bindings.push_back(&rays);
@@ -37,7 +38,7 @@ void GpuTracer::trace_buffers(const GpuAccel& accel, const Buffer& rays, const B
   pipeline_.bind(bindings);
   const lsk::LsCounters zero{};
   counters_.upload(&zero, sizeof(zero));
-  lsk::ShaderParams params = accel.params();
+  lsk::ShaderParams params = accel.params(lookup);
   params.any_hit = any_hit ? 1u : 0u;
   params.count = count;
   const auto start = std::chrono::steady_clock::now();

@@ -21,10 +21,10 @@ class GpuTracer {
   // Uploads the rays (kept for repeated traces of the same rays, e.g. bench).
   void set_rays(const std::vector<lsk::Ray>& rays);
   // Traces the rays set last; hits and counters (added to *counters) as on the CPU.
-  std::vector<lsk::Hit> trace(const GpuAccel& accel, bool any_hit, lsk::LsCounters* counters = nullptr,
+  std::vector<lsk::Hit> trace(const GpuAccel& accel, const LsLookup& lookup, bool any_hit, lsk::LsCounters* counters = nullptr,
                               GpuTraceTiming* timing = nullptr);
   // Traces the first `count` rays of a device buffer into `hits` (both stay on the device).
-  void trace_buffers(const GpuAccel& accel, const Buffer& rays, const Buffer& hits, uint32_t count, bool any_hit,
+  void trace_buffers(const GpuAccel& accel, const LsLookup& lookup, const Buffer& rays, const Buffer& hits, uint32_t count, bool any_hit,
                      lsk::LsCounters* counters = nullptr, GpuTraceTiming* timing = nullptr);
 
  private:

@@ -22,13 +22,14 @@ Usage: check_includes.py ROOT [--planted-cycle-selftest]
 import os, re, sys, tempfile
 
 SOURCE_EXTS = (".h", ".hpp", ".cpp", ".cc", ".glsl", ".comp")
-SKIP_DIRS = {"build", "out", "assets"}
+SKIP_DIRS = {"build", "out", "assets"}  # at the top only: build outputs, renders, assembled scenes
 INCLUDE_RE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 
 
 def source_files(root):
     for folder, dirs, files in os.walk(root):
-        dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.startswith("."))
+        top = os.path.samefile(folder, root)
+        dirs[:] = sorted(d for d in dirs if not (top and d in SKIP_DIRS) and not d.startswith("."))
         for name in sorted(files):
             if name.endswith(SOURCE_EXTS):
                 yield os.path.relpath(os.path.join(folder, name), root).replace(os.sep, "/")

@@ -22,6 +22,8 @@ CASES = [
       "gpu/g.cpp": '#include "cpu/pub.h"\n'}, 0, "no cycle"),
     ("angle includes ignored, skipped folders", {"a.cpp": "#include <vector>\n",
                                                   "build/x.cpp": '#include "nope.h"\n'}, 0, "no cycle"),
+    ("a folder named build below the top is checked", {"cpu/build/x.cpp": '#include "nope.h"\n'}, 1,
+     "resolves to no file"),
 ]
 
 

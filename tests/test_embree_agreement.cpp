@@ -188,8 +188,8 @@ struct AnyCounts {
 AnyCounts compare_any(const ls::Accel& accel, const ls::EmbreeTracer& embree, const std::vector<lsk::Ray>& rays,
                       const std::string& label) {
   std::vector<lsk::Hit> ours_any(rays.size()), ours_closest(rays.size()), theirs(rays.size());
-  ls::trace_rays(accel, rays.data(), ours_any.data(), rays.size(), true);
-  ls::trace_rays(accel, rays.data(), ours_closest.data(), rays.size(), false);
+  ls::trace_rays(accel, ls::LsLookup{}, rays.data(), ours_any.data(), rays.size(), true);
+  ls::trace_rays(accel, ls::LsLookup{}, rays.data(), ours_closest.data(), rays.size(), false);
   embree.trace(rays.data(), theirs.data(), rays.size(), true);
   AnyCounts c;
   c.rays = rays.size();
@@ -249,7 +249,7 @@ void check_scene(const std::string& label, const ls::Scene& scene, const std::ve
       const std::string tag = label + " " + accel.spec.name() + " " + kind_name;
       INFO(tag);
       std::vector<lsk::Hit> ours(rays.size());
-      ls::trace_rays(accel, rays.data(), ours.data(), rays.size(), false);
+      ls::trace_rays(accel, ls::LsLookup{}, rays.data(), ours.data(), rays.size(), false);
       const ClosestCounts c = compare_closest(surfaces, rays, ours, theirs, tag);
       std::cout << "[embree] closest " << tag << ": rays " << c.rays << ", hits " << c.hits << ", same ids "
                 << c.same_ids << ", ties " << c.ties << ", disagreements " << c.disagreements << " ("
@@ -437,7 +437,7 @@ TEST_CASE("embree tracer: ids, distances, barycentrics and conventions on two qu
   for (const char* name : {"bvh", "2l-bvh"}) {
     const ls::Accel accel = ls::build_accel(scene, ls::parse_structure(name));
     std::vector<lsk::Hit> ours(rays.size());
-    ls::trace_rays(accel, rays.data(), ours.data(), rays.size(), false);
+    ls::trace_rays(accel, ls::LsLookup{}, rays.data(), ours.data(), rays.size(), false);
     for (size_t i = 0; i < rays.size(); ++i) {
       INFO(name << " ray " << i);
       CHECK(ours[i].instance == hits[i].instance);

@@ -76,10 +76,11 @@ void require_candidates_equal(const Scene& scene, const std::string& structure, 
 }
 
 void require_hits_equal(const Scene& scene, const std::string& structure, const std::vector<lsk::Ray>& rays,
-                        const AccelOptions& options = paper()) {
+                        const AccelOptions& options = paper(), const LsLookup& lookup = {}) {
   for (bool any_hit : {false, true}) {
     INFO(scene.name << " " << structure << (any_hit ? " any-hit" : " closest"));
-    const validate::CrossCheckResult r = validate::cross_check_hits(device(), scene, parse_structure(structure), rays, any_hit, options);
+    const validate::CrossCheckResult r =
+        validate::cross_check_hits(device(), scene, parse_structure(structure), rays, any_hit, options, lookup);
     if (!r.ok()) validate::print_cross_check(stderr, scene.name + " " + structure + " hits", r);
     REQUIRE(r.compared == rays.size());
     REQUIRE(r.mismatches == 0);
@@ -123,8 +124,8 @@ TEST_CASE("GPU candidates and hits equal the CPU's for per-object D and N and fo
   require_candidates_equal(scene, "2l-ls:0:1", mixed);
   require_hits_equal(scene, "2l-ls:0:1", diffuse_rays(scene, 3000, 4), mixed);
   AccelOptions budget = paper();
-  budget.ls.budget = 400000;
-  budget.ls.budget_rays = 3000;
+  budget.plan.budget = 400000;
+  budget.plan.rays = 3000;
   require_candidates_equal(scene, "2l-ls:auto", budget);
 }
 
@@ -160,14 +161,14 @@ TEST_CASE("GPU hits equal the CPU's bit for bit for all four structures closest 
 }
 
 TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse", "[gpu]") {
-  AccelOptions reverse = paper();
-  reverse.ls.reverse_behind = true;
+  LsLookup reverse;
+  reverse.reverse_behind = true;
   const Scene cornell = load_scene("builtin:cornell");
   const std::vector<lsk::Ray> diffuse = diffuse_rays(cornell, 20000, 3);
-  for (const char* s : {"f-ls:3:6", "2l-ls:2:6", "2l-ls:0:10"}) require_hits_equal(cornell, s, diffuse, reverse);
+  for (const char* s : {"f-ls:3:6", "2l-ls:2:6", "2l-ls:0:10"}) require_hits_equal(cornell, s, diffuse, paper(), reverse);
   const Scene objects = load_scene("builtin:generated:1200:3:5");
   const std::vector<lsk::Ray> random = random_rays(objects, 20000, 4);  // origins inside LS boxes
-  for (const char* s : {"f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random, reverse);
+  for (const char* s : {"f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random, paper(), reverse);
 }
 
 TEST_CASE("GPU hits equal the CPU's at the extremes - flat boxes and scales 1e-20 and 1e20 and offset 1e6", "[gpu]") {
@@ -232,6 +233,15 @@ TEST_CASE("a GPU render gives the CPU render's images bit for bit", "[gpu]") {
   float sum = 0.0f;
   for (const glm::vec3& c : gpu.total) sum += c.x + c.y + c.z;
   REQUIRE(sum > 0.0f);
+  // The lookup travels with the render: the same structures at another refusal angle and behind
+  // mode give other images, and the same ones on both back ends.
+  RenderOptions other = options;
+  other.lookup.angle_degrees = 10.0f;
+  other.lookup.reverse_behind = true;
+  const RenderResult cpu_other = render(cornell, cpu_built, other);
+  const RenderResult gpu_other = gpu::render_gpu(device(), cornell, gpu_built, other);
+  REQUIRE(std::memcmp(cpu_other.total.data(), gpu_other.total.data(), cpu_other.total.size() * sizeof(glm::vec3)) == 0);
+  CHECK(std::memcmp(cpu_other.total.data(), cpu.total.data(), cpu.total.size() * sizeof(glm::vec3)) != 0);
 }
 
 namespace {

@@ -146,7 +146,7 @@ TEST_CASE("hostile glTF: denormal and zero-area triangles load and render finite
   ray.dir = glm::vec3(0.0f, 0.0f, -1.0f);
   ray.tmax = lsk::ls_infinity();
   lsk::Hit hit{};
-  trace_rays(accel, &ray, &hit, 1, false);
+  trace_rays(accel, LsLookup{}, &ray, &hit, 1, false);
   CHECK(hit.triangle < 2u);  // the quad, not a degenerate triangle
   const RenderResult r = render_small(degenerate);
   CHECK(all_finite(r));
@@ -179,10 +179,10 @@ TEST_CASE("hostile scenes: 2^31 world triangles are refused, a 2^30-triangle fla
   scene.instances.resize(size_t(1) << 14);  // 2^30 world triangles: valid, but no flat BVH fits
   REQUIRE_NOTHROW(validate_scene(scene));
   const auto start = std::chrono::steady_clock::now();
-  CHECK_THROWS_WITH(check_structure_budget(scene, parse_structure("bvh"), LsOptions{}), Contains("BVH and triangles"));
+  CHECK_THROWS_WITH(check_structure_budget(scene, parse_structure("bvh"), AccelOptions{}), Contains("BVH and triangles"));
   CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 2.0);
   // The two-level structure holds the mesh once: it fits.
-  CHECK_NOTHROW(check_structure_budget(scene, parse_structure("2l-bvh"), LsOptions{}));
+  CHECK_NOTHROW(check_structure_budget(scene, parse_structure("2l-bvh"), AccelOptions{}));
 }
 
 TEST_CASE("hostile glTF: extreme and missing cameras", "[hostile]") {

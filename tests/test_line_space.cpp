@@ -85,9 +85,9 @@ std::vector<lsk::Ray> random_rays(size_t count, uint32_t seed, glm::vec3 lo = gl
 }
 
 std::vector<lsk::Hit> trace_all(const Accel& a, const std::vector<lsk::Ray>& rays, bool any_hit = false,
-                                lsk::LsCounters* counters = nullptr) {
+                                lsk::LsCounters* counters = nullptr, const LsLookup& lookup = {}) {
   std::vector<lsk::Hit> hits(rays.size());
-  trace_rays(a, rays.data(), hits.data(), rays.size(), any_hit, counters);
+  trace_rays(a, lookup, rays.data(), hits.data(), rays.size(), any_hit, counters);
   return hits;
 }
 
@@ -126,10 +126,12 @@ AccelOptions paper() {
   return o;
 }
 
-AccelOptions angle(float degrees) {
-  AccelOptions o = paper();
-  o.ls.angle_degrees = degrees;
-  return o;
+// The lookup at a refusal angle, with the behind mode.
+LsLookup angle(float degrees, bool reverse_behind = false) {
+  LsLookup l;
+  l.angle_degrees = degrees;
+  l.reverse_behind = reverse_behind;
+  return l;
 }
 
 }  // namespace
@@ -229,7 +231,7 @@ TEST_CASE("every stored candidate equals a brute-force search over its subtree",
       const float inv_n = 1.0f / float(n);
       size_t compared = 0, nonempty = 0;
       for (const lsk::LsNode& ls : a.ls_nodes) {
-        lsk::TraceContext c = a.context();
+        lsk::TraceContext c = trace_context(a);
         for (uint32_t shaft = 0; shaft < lsk::ls_shaft_count(un); ++shaft) {
           uint32_t s, e;
           lsk::ls_shaft_patches(shaft, un, s, e);
@@ -271,12 +273,12 @@ TEST_CASE("a refusal angle of 0 gives exactly the exact structure's hits", "[lin
     const std::string p(pair);
     const std::string exact_name = p.substr(0, p.find(' ')), ls_name = p.substr(p.find(' ') + 1);
     const Accel exact = build_accel(scene, parse_structure(exact_name), paper());
-    const Accel approx = build_accel(scene, parse_structure(ls_name), angle(0.0f));
+    const Accel approx = build_accel(scene, parse_structure(ls_name), paper());
     REQUIRE(approx.ls_info.ls_nodes > 0);
     INFO(ls_name);
     lsk::LsCounters counters{};
-    REQUIRE(same_bits(trace_all(exact, rays), trace_all(approx, rays, false, &counters)));
-    REQUIRE(same_bits(trace_all(exact, rays, true), trace_all(approx, rays, true)));
+    REQUIRE(same_bits(trace_all(exact, rays), trace_all(approx, rays, false, &counters, angle(0.0f))));
+    REQUIRE(same_bits(trace_all(exact, rays, true), trace_all(approx, rays, true, nullptr, angle(0.0f))));
     CHECK(counters.lookups > 0);
     CHECK(counters.accepted == 0);
     CHECK(counters.empty == 0);
@@ -289,8 +291,8 @@ TEST_CASE("a refusal angle of 0 gives exactly the exact hits on the built-in cor
   const Accel exact_2l = build_accel(scene, parse_structure("2l-bvh"), paper());
   const std::vector<lsk::Ray> rays = generate_rays(scene, exact_flat, RayKind::Diffuse, 20000, 5);
   const auto flat = trace_all(exact_flat, rays), two = trace_all(exact_2l, rays);
-  REQUIRE(same_bits(flat, trace_all(build_accel(scene, parse_structure("f-ls:6:6"), angle(0.0f)), rays)));
-  REQUIRE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4"), angle(0.0f)), rays)));
+  REQUIRE(same_bits(flat, trace_all(build_accel(scene, parse_structure("f-ls:6:6"), paper()), rays, false, nullptr, angle(0.0f))));
+  REQUIRE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4"), paper()), rays, false, nullptr, angle(0.0f))));
   // With the default angle the approximations do change some hits: the test above can fail.
   CHECK_FALSE(same_bits(two, trace_all(build_accel(scene, parse_structure("2l-ls:2:4"), paper()), rays)));
 }
@@ -306,9 +308,9 @@ TEST_CASE("on one large planar mesh every accepted approximation lands on the pl
     r.tmax = lsk::ls_infinity();
   }
   for (const char* name : {"f-ls:3:6", "2l-ls:0:4", "f-ls:6:2"}) {
-    const Accel a = build_accel(scene, parse_structure(name), angle(89.0f));
+    const Accel a = build_accel(scene, parse_structure(name), paper());
     lsk::LsCounters counters{};
-    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters);
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters, angle(89.0f));
     INFO(name);
     REQUIRE(counters.accepted > 0);
     for (size_t i = 0; i < rays.size(); ++i) {
@@ -335,11 +337,11 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
     down.push_back(r);
   }
   for (const char* name : {"f-ls:0:1", "f-ls:0:6", "2l-ls:0:3", "2l-ls:0:2"}) {
-    const Accel a = build_accel(flat, parse_structure(name), angle(89.0f));
+    const Accel a = build_accel(flat, parse_structure(name), paper());
     const Accel exact = build_accel(flat, parse_structure("bvh"), paper());
     INFO(name);
     REQUIRE(a.ls_info.ls_nodes > 0);
-    const auto got = trace_all(a, down), want = trace_all(exact, down);
+    const auto got = trace_all(a, down, false, nullptr, angle(89.0f)), want = trace_all(exact, down);
     for (size_t i = 0; i < down.size(); ++i) {
       REQUIRE(got[i].triangle != lsk::LS_INVALID);  // no ray slips through the flat LS
       REQUIRE(got[i].t == Approx(want[i].t).epsilon(1e-5));
@@ -370,40 +372,37 @@ TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes inc
   const Scene scene = single_mesh_scene(random_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
-    const Accel a = build_accel(scene, parse_structure(name), angle(89.0f));
+    const Accel a = build_accel(scene, parse_structure(name), paper());
     lsk::LsCounters counters{};
-    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters);
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters, angle(89.0f));
     INFO(name);
     CHECK(counters.refused_behind > 0);
     CHECK(counters.refused_beyond > 0);
     CHECK(counters.accepted > 0);
     CHECK(require_in_interval(hits, rays) > 0);
-    require_in_interval(trace_all(a, rays, true), rays);  // any-hit answers stay inside the interval too
+    require_in_interval(trace_all(a, rays, true, nullptr, angle(89.0f)), rays);  // any-hit answers stay inside the interval too
   }
 }
 
 TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, and nothing is refused as behind", "[line_space]") {
   const Scene scene = single_mesh_scene(random_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
-  AccelOptions reverse = angle(89.0f);
-  reverse.ls.reverse_behind = true;
+  const LsLookup reverse = angle(89.0f, true);
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
     INFO(name);
     lsk::LsCounters exact_counters{}, reverse_counters{};
-    trace_all(build_accel(scene, parse_structure(name), angle(89.0f)), rays, false, &exact_counters);
-    const Accel a = build_accel(scene, parse_structure(name), reverse);
-    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &reverse_counters);
+    const Accel a = build_accel(scene, parse_structure(name), paper());  // one build: the lookup alone differs
+    trace_all(a, rays, false, &exact_counters, angle(89.0f));
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &reverse_counters, reverse);
     REQUIRE(exact_counters.refused_behind > 0);
     CHECK(reverse_counters.refused_behind == 0);
     // The behind refusals became answers: more accepted or empty, the same lookups before them.
     CHECK(reverse_counters.accepted + reverse_counters.empty > exact_counters.accepted + exact_counters.empty);
     CHECK(require_in_interval(hits, rays) > 0);
-    require_in_interval(trace_all(a, rays, true), rays);
+    require_in_interval(trace_all(a, rays, true, nullptr, reverse), rays);
   }
   // A refusal angle of 0 still refuses everything: the exact structure's hits.
-  AccelOptions none = angle(0.0f);
-  none.ls.reverse_behind = true;
-  REQUIRE(same_bits(trace_all(build_accel(scene, parse_structure("f-ls:3:6"), none), rays),
+  REQUIRE(same_bits(trace_all(build_accel(scene, parse_structure("f-ls:3:6"), paper()), rays, false, nullptr, angle(0.0f, true)),
                     trace_all(build_accel(scene, parse_structure("bvh"), paper()), rays)));
 }
 
@@ -445,17 +444,14 @@ TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the r
   REQUIRE(want[3].triangle == lsk::LS_INVALID);
   for (const char* name : {"f-ls:0:4", "f-ls:0:6", "2l-ls:0:5"}) {
     INFO(name);
-    AccelOptions reverse = angle(45.0f);
-    reverse.ls.reverse_behind = true;
-    const Accel by_exact = build_accel(scene, parse_structure(name), angle(45.0f));
-    const Accel by_reverse = build_accel(scene, parse_structure(name), reverse);
-    REQUIRE(by_reverse.ls_info.ls_nodes == 1);
+    const Accel a = build_accel(scene, parse_structure(name), paper());
+    REQUIRE(a.ls_info.ls_nodes == 1);
     for (size_t i = 0; i < rays.size(); ++i) {
       INFO("ray " << i);
       const std::vector<lsk::Ray> one = {rays[i]};
       lsk::LsCounters e{}, r{};
-      const lsk::Hit got_exact = trace_all(by_exact, one, false, &e)[0];
-      const lsk::Hit got = trace_all(by_reverse, one, false, &r)[0];
+      const lsk::Hit got_exact = trace_all(a, one, false, &e, angle(45.0f))[0];
+      const lsk::Hit got = trace_all(a, one, false, &r, angle(45.0f, true))[0];
       REQUIRE(e.refused_behind == 1);  // every ray starts behind its shaft's first candidate
       REQUIRE(r.refused_behind == 0);
       REQUIRE(got_exact.t == want[i].t);  // refused: the subtree traversed exactly
@@ -598,7 +594,7 @@ TEST_CASE("compact and paper candidates give identical hits and compact is small
 TEST_CASE("an over-budget Line Space is refused before it is built", "[line_space]") {
   const Scene scene = single_mesh_scene(random_soup(5000, 2));
   AccelOptions tight = paper();
-  tight.ls.max_memory = 1 << 20;
+  tight.limits.max_memory = 1 << 20;
   const auto start = std::chrono::steady_clock::now();
   REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:4:64"), tight), InputError);
   REQUIRE_THROWS_AS(build_accel(scene, parse_structure("f-ls:8:64"), paper()), InputError);  // ~256 nodes x 2 GB

@@ -1,4 +1,4 @@
-// Per-object Line Space parameters (LsOptions::objects) and 2l-ls:auto (cpu/ls_budget.h): each object's
+// Per-object Line Space parameters (LsBuildOptions::objects) and 2l-ls:auto (cpu/ls_budget.h): each object's
 // Line Space equals the one a uniform structure gives it, the budget holds, the pilot's lazily searched
 // shafts answer like a full build, and the optimiser keeps its guarantees against brute force.
 #include "common/structure/accel.h"
@@ -22,17 +22,16 @@ namespace {
 
 const char* kScene = "builtin:generated:12000:6:3";  // six ellipsoids and a light quad, 2 triangles
 
-AccelOptions with_objects(std::vector<ObjectLs> objects, float angle = 45.0f) {
+AccelOptions with_objects(std::vector<ObjectLs> objects) {
   AccelOptions o;
   o.ls.objects = std::move(objects);
-  o.ls.angle_degrees = angle;
   return o;
 }
 
 AccelOptions with_budget(double mb, size_t rays = 4096) {
   AccelOptions o;
-  o.ls.budget = size_t(mb * 1e6);
-  o.ls.budget_rays = rays;
+  o.plan.budget = size_t(mb * 1e6);
+  o.plan.rays = rays;
   return o;
 }
 
@@ -41,9 +40,10 @@ const lsk::LsNode* ls_at(const Accel& accel, uint32_t node) {
   return accel.node_ls[node] == lsk::LS_INVALID ? nullptr : &accel.ls_nodes[accel.node_ls[node]];
 }
 
-std::vector<lsk::Hit> trace_all(const Accel& a, const std::vector<lsk::Ray>& rays, Traversal t = Traversal::Reference) {
+std::vector<lsk::Hit> trace_all(const Accel& a, const std::vector<lsk::Ray>& rays, Traversal t = Traversal::Reference,
+                                const LsLookup& lookup = {}) {
   std::vector<lsk::Hit> hits(rays.size());
-  trace_rays(a, rays.data(), hits.data(), rays.size(), false, nullptr, t);
+  trace_rays(a, lookup, rays.data(), hits.data(), rays.size(), false, nullptr, t);
   return hits;
 }
 
@@ -63,7 +63,7 @@ TEST_CASE("per-object Line Spaces equal those a uniform structure gives each obj
   for (const lsk::LsNode& ls : mixed.ls_nodes) shafts += lsk::ls_shaft_count(ls.n);
   CHECK(mixed.ls_info.shafts == shafts);
 
-  lsk::TraceContext cm = mixed.context();
+  lsk::TraceContext cm = trace_context(mixed);
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     INFO("mesh " << m);
     const uint32_t root = mixed.object_roots[m];
@@ -74,7 +74,7 @@ TEST_CASE("per-object Line Spaces equal those a uniform structure gives each obj
     }
     const std::string name = "2l-ls:" + std::to_string(objects[m].depth) + ":" + std::to_string(objects[m].n);
     const Accel uniform = build_accel(scene, parse_structure(name));
-    lsk::TraceContext cu = uniform.context();
+    lsk::TraceContext cu = trace_context(uniform);
     size_t compared = 0;
     for (uint32_t node = root; node < end; ++node) {
       const lsk::LsNode* a = ls_at(mixed, node);
@@ -99,10 +99,12 @@ TEST_CASE("per-object Line Spaces with refusal angle 0 give the exact structure'
   objects[2] = {0, 5};
   objects[4] = {};
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
-  const Accel mixed = build_accel(scene, parse_structure("2l-ls:0:1"), with_objects(objects, 0.0f));
+  const Accel mixed = build_accel(scene, parse_structure("2l-ls:0:1"), with_objects(objects));
+  LsLookup refuse_all;
+  refuse_all.angle_degrees = 0.0f;
   const std::vector<lsk::Ray> rays = generate_rays(scene, exact, RayKind::Diffuse, 20000, 5);
   for (Traversal t : {Traversal::Reference, Traversal::Fast}) {
-    const std::vector<lsk::Hit> a = trace_all(exact, rays, t), b = trace_all(mixed, rays, t);
+    const std::vector<lsk::Hit> a = trace_all(exact, rays, t), b = trace_all(mixed, rays, t, refuse_all);
     REQUIRE(std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0);
   }
 }
@@ -138,7 +140,7 @@ TEST_CASE("2l-ls:auto is refused without a budget, below its fixed part, and ove
   CHECK_THROWS_WITH(build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(0.01)),
                     Catch::Contains("raise --ls-budget"));
   AccelOptions small = with_budget(500.0);
-  small.ls.max_memory = 100000000;  // 100 MB: the 500 MB budget itself is over it
+  small.limits.max_memory = 100000000;  // 100 MB: the 500 MB budget itself is over it
   CHECK_THROWS_WITH(build_planned_accel(scene, parse_structure("2l-ls:auto"), small), Catch::Contains("--ls-budget"));
   CHECK(parse_structure("2l-ls:auto").name() == "2l-ls:auto");
   CHECK(parse_structure("2L-LS:AUTO").budgeted);
@@ -155,7 +157,7 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
   const Accel planned = build_planned_accel(scene, parse_structure("2l-ls:auto"), options);
   const LsPlan& plan = *planned.ls_plan;
   REQUIRE(!plan.reference.empty());
-  const LsPilot pilot = ls_budget_pilot(scene, exact, options.ls.budget_rays);
+  const LsPilot pilot = ls_budget_pilot(scene, exact, options.plan.rays);
   REQUIRE(pilot.rays.size() == plan.pilot_rays);
   REQUIRE(pilot.shadow_rays.size() == plan.pilot_shadow_rays);
   REQUIRE(plan.pilot_shadow_rays > 0);  // the generated scene has a light quad
@@ -165,8 +167,8 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
     for (bool any_hit : {false, true}) {
       const std::vector<lsk::Ray>& rays = any_hit ? pilot.shadow_rays : pilot.rays;
       std::vector<lsk::Hit> truth(rays.size()), got(rays.size());
-      trace_rays(exact, rays.data(), truth.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
-      trace_rays(a, rays.data(), got.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
+      trace_rays(exact, LsLookup{}, rays.data(), truth.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
+      trace_rays(a, LsLookup{}, rays.data(), got.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
       for (size_t i = 0; i < rays.size(); ++i) wrong += pilot_answer_wrong(rays[i], got[i], truth[i], any_hit, tolerance);
     }
     return wrong;

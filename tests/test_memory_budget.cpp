@@ -32,7 +32,7 @@ TEST_CASE("structure estimates bound the bytes the built structures hold", "[bud
       options.ls.paper_candidates = true;  // the largest candidates the estimate must cover
       options.ls.min_triangles = 1;
       const Accel accel = build_accel(scene, spec, options);
-      const StructureEstimate e = estimate_structure_bytes(scene, spec, options.ls);
+      const StructureEstimate e = estimate_structure_bytes(scene, spec, options);
       INFO(scene_name << " " << name << ": estimate " << e.total() << ", built " << accel.bytes_total());
       CHECK(e.total() >= accel.bytes_total());
       CHECK(e.ls_bytes >= accel.bytes_ls());
@@ -74,20 +74,20 @@ TEST_CASE("the fast path's bound covers its wide trees and blocks, and a structu
   options.search_candidates = false;
   const Accel fits = build_accel(scene, spec, options);
   const size_t whole = fits.bytes_total() + fits.bytes_wide();
-  options.ls.max_memory = estimate_structure_bytes(scene, spec, options.ls).total();
-  INFO("estimate " << options.ls.max_memory << ", structure and fast path " << whole);
-  REQUIRE(options.ls.max_memory < whole);
+  options.limits.max_memory = estimate_structure_bytes(scene, spec, options).total();
+  INFO("estimate " << options.limits.max_memory << ", structure and fast path " << whole);
+  REQUIRE(options.limits.max_memory < whole);
   CHECK_THROWS_WITH(build_accel(scene, spec, options),
                     Contains("fast path") && Contains("triangle blocks") && Contains("over the budget") &&
                         Contains("--max-memory"));
-  options.ls.max_memory = whole + fast_path_bytes_at_most(fits, options.wide_width, options.exact_width);
+  options.limits.max_memory = whole + fast_path_bytes_at_most(fits, options.wide_width, options.exact_width);
   CHECK_NOTHROW(build_accel(scene, spec, options));
 }
 
 TEST_CASE("N = 64 and D = 30 on builtin:instances are refused in well under 2 s", "[budget]") {
   const Scene scene = builtin_scene("instances");
   AccelOptions options;
-  options.ls.max_memory = size_t(4) << 30;  // 4 GiB: the same answer on any machine
+  options.limits.max_memory = size_t(4) << 30;  // 4 GiB: the same answer on any machine
   for (const char* name : {"f-ls:8:64", "2l-ls:4:64", "f-ls:30:10"}) {
     INFO(name);
     const auto start = std::chrono::steady_clock::now();
@@ -97,7 +97,7 @@ TEST_CASE("N = 64 and D = 30 on builtin:instances are refused in well under 2 s"
     CHECK(seconds_since(start) < 2.0);
   }
   // The BVH alone counts too: 3.3 million world triangles do not fit in 16 MB.
-  options.ls.max_memory = size_t(16) << 20;
+  options.limits.max_memory = size_t(16) << 20;
   CHECK_THROWS_WITH(build_accel(scene, parse_structure("bvh"), options),
                     Contains("BVH and triangles") && Contains("--max-memory"));
 }
@@ -117,9 +117,9 @@ TEST_CASE("the Line Space layout re-checks the budget with its actual LS nodes, 
   const Scene scene = load_scene("builtin:cornell");
   Accel accel = build_accel(scene, parse_structure("f-ls:3:8"));
   REQUIRE(accel.ls_info.ls_nodes > 0);
-  LsOptions tight = accel.ls_options;
+  Limits tight;
   tight.max_memory = 1000000;  // 1 MB = 0.95 MiB: a budget is named rounded down, in tenths, "0.9 MiB"
-  CHECK_THROWS_WITH(layout_line_space(scene, tight, accel),
+  CHECK_THROWS_WITH(layout_line_space(scene, accel.ls_options, tight, accel),
                     Contains("structure 'f-ls:3:8': its Line Space would take about") &&
                         Contains(std::to_string(accel.ls_info.ls_nodes) + " LS nodes x") && Contains("over the budget of 0.9 MiB") &&
                         Contains("lower N or D, or raise --max-memory"));

@@ -180,9 +180,13 @@ std::vector<lsk::Hit> brute_force(const ls::Scene& s, const std::vector<lsk::Ray
   return hits;
 }
 
+// Traced with a refusal angle of 0: a Line Space refuses every approximation and must equal the
+// exact structure (exact_ls()).
 std::vector<lsk::Hit> trace(const ls::Accel& a, const std::vector<lsk::Ray>& rays, ls::Traversal traversal, bool any_hit = false) {
   std::vector<lsk::Hit> hits(rays.size());
-  ls::trace_rays(a, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal);
+  ls::LsLookup refuse_all;
+  refuse_all.angle_degrees = 0.0f;
+  ls::trace_rays(a, refuse_all, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal);
   return hits;
 }
 
@@ -201,9 +205,8 @@ size_t differences(const std::vector<lsk::Hit>& a, const std::vector<lsk::Hit>& 
   return n;
 }
 
-ls::AccelOptions exact_ls() {
+ls::AccelOptions exact_ls() {  // traced by trace() with a refusal angle of 0
   ls::AccelOptions o;
-  o.ls.angle_degrees = 0.0f;  // refuses every approximation: must equal the exact structure
   o.ls.min_triangles = 0;
   return o;
 }

@@ -293,7 +293,7 @@ std::vector<lsk::Hit> brute_all(const WorldTris& w, const std::vector<lsk::Ray>&
 
 std::vector<lsk::Hit> trace_all(const ls::Accel& a, const std::vector<lsk::Ray>& rays, bool any_hit = false) {
   std::vector<lsk::Hit> hits(rays.size());
-  ls::trace_rays(a, rays.data(), hits.data(), rays.size(), any_hit);
+  ls::trace_rays(a, ls::LsLookup{}, rays.data(), hits.data(), rays.size(), any_hit);
   return hits;
 }
 

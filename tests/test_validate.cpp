@@ -37,11 +37,12 @@ void quiet(const std::string&) {}
 TEST_CASE("refusal angle 0: every Line Space gives RMSE 0 on every bounce", "[validate]") {
   const Scene scene = load_scene("builtin:cornell");
   AccelOptions options;
-  options.ls.angle_degrees = 0.0f;
   options.ls.min_triangles = 0;
   StudyRenderer renderer(make_cpu_backend(), scene, options);
+  ImageSettings refuse_all = tiny_image();
+  refuse_all.lookup.angle_degrees = 0.0f;
   const RmseStudy study = run_rmse_study(renderer, "builtin:cornell", parse_structure_list("f-ls:6:4,2l-ls:2:4"),
-                                         tiny_image(), "", 0.1f, quiet);
+                                         refuse_all, "", 0.1f, quiet);
   REQUIRE(study.rows.size() == 6);
   for (const RmseRow& r : study.rows) {
     INFO(r.structure << " from bounce " << r.start_bounce);

@@ -56,13 +56,14 @@ std::string describe(const lsk::LsCounters& c) {
 
 // Runs both paths on the same rays and requires identical hit records and counters; returns the
 // number of Line Space lookups.
-size_t require_same(const ls::Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, const std::string& what) {
+size_t require_same(const ls::Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, const std::string& what,
+                    const ls::LsLookup& lookup = {}) {
   INFO(what << ", " << accel.spec.name() << ", " << accel.fast->width() << "-wide treelets, " << accel.fast->exact_width()
             << "-wide order-free tree, " << (any_hit ? "any hit" : "closest hit"));
   std::vector<lsk::Hit> ref(rays.size()), fast(rays.size());
   lsk::LsCounters ref_counters{}, fast_counters{};
-  ls::trace_rays(accel, rays.data(), ref.data(), rays.size(), any_hit, &ref_counters, ls::Traversal::Reference);
-  ls::trace_rays(accel, rays.data(), fast.data(), rays.size(), any_hit, &fast_counters, ls::Traversal::Fast);
+  ls::trace_rays(accel, lookup, rays.data(), ref.data(), rays.size(), any_hit, &ref_counters, ls::Traversal::Reference);
+  ls::trace_rays(accel, lookup, rays.data(), fast.data(), rays.size(), any_hit, &fast_counters, ls::Traversal::Fast);
   size_t mismatches = 0, hits = 0;
   std::string first;
   for (size_t i = 0; i < rays.size(); ++i) {
@@ -82,11 +83,10 @@ size_t require_same(const ls::Accel& accel, const std::vector<lsk::Ray>& rays, b
 }
 
 // width: the treelets' and the order-free tree's, unless exact_width names the latter.
-ls::AccelOptions options(int width, float angle = 45.0f, uint32_t min_triangles = 0, int exact_width = 0) {
+ls::AccelOptions options(int width, uint32_t min_triangles = 0, int exact_width = 0) {
   ls::AccelOptions o;
   o.wide_width = width;
   o.exact_width = exact_width != 0 ? exact_width : width;
-  o.ls.angle_degrees = angle;
   o.ls.min_triangles = min_triangles;
   return o;
 }
@@ -217,8 +217,10 @@ TEST_CASE("wide BVH: same answers at refusal angles 0 and 89 degrees and with sm
   for (float angle : {0.0f, 89.0f})
     for (uint32_t min_tris : {0u, 8u})
       for (const char* s : {"f-ls:5:4", "2l-ls:3:4"}) {
-        const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4, angle, min_tris));
-        CHECK(require_same(a, rays, false, "angle " + std::to_string(angle) + ", min triangles " + std::to_string(min_tris)) > 0);
+        const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4, min_tris));
+        ls::LsLookup lookup;
+        lookup.angle_degrees = angle;
+        CHECK(require_same(a, rays, false, "angle " + std::to_string(angle) + ", min triangles " + std::to_string(min_tris), lookup) > 0);
       }
 }
 
@@ -230,12 +232,12 @@ TEST_CASE("wide BVH: same answers and counters with --ls-behind reverse", "[wide
       const std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::parse_ray_kind(kind), 3000, 9);
       for (int width : {4, 8})
         for (const char* s : {"f-ls:4:4", "f-ls:8:6", "2l-ls:2:4", "2l-ls:0:6"}) {
-          ls::AccelOptions o = options(width);
-          o.ls.reverse_behind = true;
-          const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), o);
+          const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width));
+          ls::LsLookup reverse;
+          reverse.reverse_behind = true;
           const std::string what = std::string(scene_name) + ", " + kind + " rays, reverse";
-          CHECK(require_same(a, rays, false, what) > 0);
-          CHECK(require_same(a, rays, true, what) > 0);
+          CHECK(require_same(a, rays, false, what, reverse) > 0);
+          CHECK(require_same(a, rays, true, what, reverse) > 0);
         }
     }
   }
@@ -264,7 +266,7 @@ TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degen
   rays.push_back(ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.2f, 0.1f), 0.0f, std::numeric_limits<float>::quiet_NaN()));
   for (const auto& [width, exact_width] : {std::pair{4, 4}, {8, 8}, {4, 8}, {8, 4}})
     for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
-      const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width, 45.0f, 0u, exact_width));
+      const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width, 0u, exact_width));
       REQUIRE(a.fast->exact_width() == exact_width);
       require_same(a, rays, false, "special rays");
       require_same(a, rays, true, "special rays");
@@ -306,8 +308,8 @@ TEST_CASE("wide BVH: a build without the fast path (the GPU port's) traces with 
     CHECK(none.traversal == ls::Traversal::Reference);
     const ls::Accel with = ls::build_accel(scene, ls::parse_structure(s));
     std::vector<lsk::Hit> a(rays.size()), b(rays.size());
-    ls::trace_rays(none, rays.data(), a.data(), rays.size(), false);
-    ls::trace_rays(with, rays.data(), b.data(), rays.size(), false);
+    ls::trace_rays(none, ls::LsLookup{}, rays.data(), a.data(), rays.size(), false);
+    ls::trace_rays(with, ls::LsLookup{}, rays.data(), b.data(), rays.size(), false);
     CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0);
   }
 }
@@ -331,8 +333,8 @@ TEST_CASE("wide BVH: rays with infinite or NaN components take the ordered walk 
   for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
     const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
     std::vector<lsk::Hit> ref(rays.size()), fast(rays.size());
-    ls::trace_rays(a, rays.data(), ref.data(), rays.size(), false, nullptr, ls::Traversal::Reference);
-    ls::trace_rays(a, rays.data(), fast.data(), rays.size(), false, nullptr, ls::Traversal::Fast);
+    ls::trace_rays(a, ls::LsLookup{}, rays.data(), ref.data(), rays.size(), false, nullptr, ls::Traversal::Reference);
+    ls::trace_rays(a, ls::LsLookup{}, rays.data(), fast.data(), rays.size(), false, nullptr, ls::Traversal::Fast);
     size_t mismatches = 0;
     for (size_t i = 0; i < rays.size(); ++i) mismatches += std::memcmp(&ref[i], &fast[i], sizeof(lsk::Hit)) != 0;
     INFO(s);
@@ -895,7 +897,7 @@ TEST_CASE("wide BVH: the candidate search on the fast path stores the reference 
         o.ls.further_rays = further;
         const ls::Accel a = ls::build_accel(k.scene, ls::parse_structure(s), o);
         REQUIRE(a.ls_info.ls_nodes > 0);
-        lsk::TraceContext c = a.context();
+        lsk::TraceContext c = ls::trace_context(a);
         c.ls_enabled = 0;
         const uint32_t instance = ls::ls_search_instance(a);
         size_t shafts = 0, mismatches = 0, found = 0;
@@ -917,8 +919,8 @@ TEST_CASE("wide BVH: occlusion queries miss exactly where the reference's any hi
     INFO(what << ", " << a.spec.name());
     std::vector<lsk::Hit> ref(rays.size()), occ(rays.size());
     lsk::LsCounters ref_counters{}, occ_counters{};
-    ls::trace_rays(a, rays.data(), ref.data(), rays.size(), true, &ref_counters, ls::Traversal::Reference);
-    ls::trace_occlusion(a, rays.data(), occ.data(), rays.size(), &occ_counters, ls::Traversal::Fast);
+    ls::trace_rays(a, ls::LsLookup{}, rays.data(), ref.data(), rays.size(), true, &ref_counters, ls::Traversal::Reference);
+    ls::trace_occlusion(a, ls::LsLookup{}, rays.data(), occ.data(), rays.size(), &occ_counters, ls::Traversal::Fast);
     size_t blocked = 0, wrong_blocking = 0, unverified = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
       const bool ref_blocked = ref[i].triangle != lsk::LS_INVALID;
@@ -939,7 +941,7 @@ TEST_CASE("wide BVH: occlusion queries miss exactly where the reference's any hi
         bool found = false;
         for (const lsk::InstanceRecord& rec : a.instances)
           if (rec.instance == occ[i].instance) {
-            lsk::TraceContext c = a.context();
+            lsk::TraceContext c = ls::trace_context(a);
             c.instance_ray(rec, rays[i].origin, rays[i].dir, o, d);
             // the object's triangles: those in the subtree of rec.root with this id
             for (k = 0; k < a.tri_ids.size(); ++k) {

@@ -19,19 +19,24 @@ struct Traced {
   lsk::LsCounters counters{};
 };
 
-Traced reference_work(const Accel& accel, const std::vector<lsk::Ray>& rays, bool split = true) {
+Traced reference_work(const Accel& accel, const std::vector<lsk::Ray>& rays, bool split = true, const LsLookup& lookup = {}) {
   Traced t;
   std::vector<lsk::Hit> hits(rays.size());
   const std::vector<uint8_t> ls_subtrees = split ? line_space_subtrees(accel) : std::vector<uint8_t>();
-  trace_rays(accel, rays.data(), hits.data(), rays.size(), false, &t.counters, Traversal::Reference, &t.work, &ls_subtrees);
+  trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), false, &t.counters, Traversal::Reference, &t.work, &ls_subtrees);
   return t;
 }
 
-AccelOptions options_with_angle(float degrees) {
+AccelOptions paper() {
   AccelOptions o;
-  o.ls.angle_degrees = degrees;
   o.ls.min_triangles = 0;  // the paper's behaviour: every node at depth D, small ones too
   return o;
+}
+
+LsLookup refuse_all() {  // a refusal angle of 0: every lookup refused
+  LsLookup l;
+  l.angle_degrees = 0.0f;
+  return l;
 }
 
 // Rays whose line enters the box of nodes[root] within [tmin, tmax], as the kernel's root test decides.
@@ -56,8 +61,8 @@ TEST_CASE("every lookup refused, a Line Space structure does its BVH's work and 
   REQUIRE(flat_exact.work.box_tests > rays.size());
   for (const char* name : {"f-ls:0:2", "f-ls:3:4", "f-ls:6:2", "2l-ls:0:2", "2l-ls:2:3"}) {
     INFO(name);
-    const Accel accel = build_accel(scene, parse_structure(name), options_with_angle(0.0f));
-    const Traced t = reference_work(accel, rays);
+    const Accel accel = build_accel(scene, parse_structure(name), paper());
+    const Traced t = reference_work(accel, rays, true, refuse_all());
     const Traced& exact = accel.spec.two_level() ? two_level_exact : flat_exact;
     CHECK(t.work.box_tests == exact.work.box_tests);
     CHECK(t.work.triangle_tests == exact.work.triangle_tests);
@@ -68,7 +73,7 @@ TEST_CASE("every lookup refused, a Line Space structure does its BVH's work and 
     CHECK(exact.work.box_tests_in_ls == 0);  // no Line Space, nothing below one
     CHECK(exact.work.triangle_tests_in_ls == 0);
     // Not asked for, the split is not made: the same totals, nothing counted apart.
-    const Traced unsplit = reference_work(accel, rays, false);
+    const Traced unsplit = reference_work(accel, rays, false, refuse_all());
     CHECK(unsplit.work.box_tests == t.work.box_tests);
     CHECK(unsplit.work.triangle_tests == t.work.triangle_tests);
     CHECK(unsplit.work.box_tests_in_ls == 0);
@@ -91,14 +96,14 @@ TEST_CASE("the split at D = 0 and D = 1 has its closed form", "[work_bound]") {
   REQUIRE(bvh.nodes[0].count == 0);
   {
     // The root is the Line Space node: only the root's own box test is outside it.
-    const Traced t = reference_work(build_accel(scene, parse_structure("f-ls:0:2"), options_with_angle(0.0f)), rays);
+    const Traced t = reference_work(build_accel(scene, parse_structure("f-ls:0:2"), paper()), rays, true, refuse_all());
     CHECK(t.work.box_tests - t.work.box_tests_in_ls == rays.size());
     CHECK(t.work.triangle_tests_in_ls == t.work.triangle_tests);
     CHECK(t.work.lookups == entering);
   }
   {
     // The root's two children are: the root's box and, for the rays that enter it, its children's.
-    const Traced t = reference_work(build_accel(scene, parse_structure("f-ls:1:2"), options_with_angle(0.0f)), rays);
+    const Traced t = reference_work(build_accel(scene, parse_structure("f-ls:1:2"), paper()), rays, true, refuse_all());
     CHECK(t.work.box_tests - t.work.box_tests_in_ls == rays.size() + 2 * entering);
     CHECK(t.work.triangle_tests_in_ls == t.work.triangle_tests);
   }
@@ -108,7 +113,7 @@ TEST_CASE("the Line Space subtrees are the nodes whose triangles lie within a Li
   const Scene scene = load_scene("builtin:generated:3000:6:2");
   for (const char* name : {"f-ls:0:2", "f-ls:4:2", "f-ls:9:2", "2l-ls:0:2", "2l-ls:3:2", "f-ls:60:2", "bvh"}) {
     INFO(name);
-    const Accel accel = build_accel(scene, parse_structure(name), options_with_angle(45.0f));
+    const Accel accel = build_accel(scene, parse_structure(name), paper());
     const std::vector<uint8_t> in_ls = line_space_subtrees(accel);
     if (!accel.spec.line_space()) {
       CHECK(in_ls.empty());
@@ -164,12 +169,12 @@ TEST_CASE("bound: the oracle is the exact work outside the Line Space nodes plus
   const Accel bvh = build_accel(scene, parse_structure("bvh"));
   const std::vector<lsk::Ray> rays = generate_rays(scene, bvh, RayKind::Diffuse, 3000, 5);
   const std::vector<StructureSpec> specs = parse_structure_list("f-ls:3:4,2l-ls:1:3,f-ls:60:2");
-  const BoundStudy study = run_bound_study(scene, "builtin:cornell", rays, "diffuse", specs, options_with_angle(45.0f), [](const std::string&) {});
+  const BoundStudy study = run_bound_study(scene, "builtin:cornell", rays, "diffuse", specs, paper(), LsLookup{}, [](const std::string&) {});
   REQUIRE(study.rows.size() == 3);
   const Traced flat_exact = reference_work(bvh, rays);
   for (const BoundRow& row : study.rows) {
     INFO(row.structure);
-    const Accel accel = build_accel(scene, parse_structure(row.structure), options_with_angle(45.0f));
+    const Accel accel = build_accel(scene, parse_structure(row.structure), paper());
     const Traced traced = reference_work(accel, rays);
     CHECK(row.traced_work.box_tests == traced.work.box_tests);
     CHECK(row.traced_work.lookups == traced.work.lookups);
@@ -187,7 +192,7 @@ TEST_CASE("bound: the oracle is the exact work outside the Line Space nodes plus
   CHECK(study.rows[2].ls_nodes == 0);
   CHECK(study.rows[2].bound() == 1.0);
   CHECK(study.rows[2].achieved() == 1.0);
-  CHECK_THROWS_AS(run_bound_study(scene, "s", rays, "r", parse_structure_list("bvh"), AccelOptions{}, [](const std::string&) {}),
+  CHECK_THROWS_AS(run_bound_study(scene, "s", rays, "r", parse_structure_list("bvh"), AccelOptions{}, LsLookup{}, [](const std::string&) {}),
                   InputError);
-  CHECK_THROWS_AS(run_bound_study(scene, "s", {}, "r", specs, AccelOptions{}, [](const std::string&) {}), InputError);
+  CHECK_THROWS_AS(run_bound_study(scene, "s", {}, "r", specs, AccelOptions{}, LsLookup{}, [](const std::string&) {}), InputError);
 }

@@ -11,11 +11,12 @@
 namespace ls {
 namespace {
 
-TraceWorkTotals traced_work(const Accel& accel, const std::vector<lsk::Ray>& rays, lsk::LsCounters& counters) {
+TraceWorkTotals traced_work(const Accel& accel, const LsLookup& lookup, const std::vector<lsk::Ray>& rays,
+                            lsk::LsCounters& counters) {
   std::vector<lsk::Hit> hits(rays.size());
   TraceWorkTotals work;
   const std::vector<uint8_t> ls_subtrees = line_space_subtrees(accel);
-  trace_rays(accel, rays.data(), hits.data(), rays.size(), false, &counters, Traversal::Reference, &work, &ls_subtrees);
+  trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), false, &counters, Traversal::Reference, &work, &ls_subtrees);
   return work;
 }
 
@@ -41,7 +42,7 @@ double BoundRow::share_below_ls() const {
 
 BoundStudy run_bound_study(const Scene& scene, const std::string& scene_name, const std::vector<lsk::Ray>& rays,
                            const std::string& rays_name, const std::vector<StructureSpec>& specs, const AccelOptions& options,
-                           const std::function<void(const std::string&)>& log) {
+                           const LsLookup& lookup, const std::function<void(const std::string&)>& log) {
   for (const StructureSpec& s : specs)
     if (!s.line_space())
       throw InputError("bound: --structures takes Line Space structures (f-ls:D:N, 2l-ls:D:N, 2l-ls:auto), not '" + s.name() +
@@ -53,18 +54,17 @@ BoundStudy run_bound_study(const Scene& scene, const std::string& scene_name, co
   study.ray_count = rays.size();
   for (const StructureSpec& spec : specs) {
     const auto t0 = std::chrono::steady_clock::now();
-    Accel accel = build_planned_accel(scene, spec, options);
+    const Accel accel = build_planned_accel(scene, spec, options);
     BoundRow row;
     row.structure = spec.name();
     row.exact = spec.two_level() ? "2l-bvh" : "bvh";
     row.ls_nodes = accel.ls_info.ls_nodes;
     // A refusal angle of 0 refuses every lookup (ls_lookup.h): the walk is the BVH's own, node for node.
-    const float angle = accel.ls_options.angle_degrees;
-    accel.ls_options.angle_degrees = 0.0f;
+    LsLookup refuse_all = lookup;
+    refuse_all.angle_degrees = 0.0f;
     lsk::LsCounters refused{};
-    row.exact_work = traced_work(accel, rays, refused);
-    accel.ls_options.angle_degrees = angle;
-    row.traced_work = traced_work(accel, rays, row.traced);
+    row.exact_work = traced_work(accel, refuse_all, rays, refused);
+    row.traced_work = traced_work(accel, lookup, rays, row.traced);
     study.rows.push_back(row);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     log(row.structure + ": bound " + fixed(row.bound(), 2) + "x, achieved " + fixed(row.achieved(), 2) + "x its " + row.exact +

@@ -51,7 +51,7 @@ struct BoundStudy {
 // on the reference kernels, on all threads.  log: one line per structure.
 BoundStudy run_bound_study(const Scene& scene, const std::string& scene_name, const std::vector<lsk::Ray>& rays,
                            const std::string& rays_name, const std::vector<StructureSpec>& specs, const AccelOptions& options,
-                           const std::function<void(const std::string&)>& log);
+                           const LsLookup& lookup, const std::function<void(const std::string&)>& log);
 
 // bound.md, bound.csv, bound.json into dir.
 void write_bound_study(const std::string& dir, const BoundStudy& study);

@@ -50,11 +50,11 @@ bool BudgetComparison::lower_rmse() const {
 }
 
 BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, const std::vector<StructureSpec>& uniform,
-                             const ImageSettings& settings, const LsOptions& ls, const Log& log) {
+                             const ImageSettings& settings, const LsPlanOptions& plan, const Log& log) {
   for (const StructureSpec& s : uniform)
     if (s.kind != StructureKind::TwoLevelLs || s.budgeted)
       throw InputError("budget: --uniform takes 2l-ls:D:N structures, not '" + s.name() + "'");
-  if (ls.budget != 0) throw InputError("budget: each comparison's budget is its uniform structure's bytes_ls; drop --ls-budget");
+  if (plan.budget != 0) throw InputError("budget: each comparison's budget is its uniform structure's bytes_ls; drop --ls-budget");
   BudgetStudy study;
   study.scene = scene;
   study.device = renderer.device();
@@ -67,7 +67,6 @@ BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, 
   for (const StructureSpec& spec : uniform) {
     BudgetComparison row;
     row.uniform_name = spec.name();
-    renderer.set_ls_options(ls);
     try {
       row.uniform = measure_side(renderer, spec, settings, reference, log);
     } catch (const InputError& e) {
@@ -77,9 +76,10 @@ BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, 
       continue;
     }
     row.budget = row.uniform.bytes_ls;
-    LsOptions budgeted = ls;
+    LsPlanOptions budgeted = plan;
     budgeted.budget = row.budget;
-    renderer.set_ls_options(budgeted);  // drops the uniform structure
+    renderer.release(spec);  // the uniform structure is not held beside the planned one
+    renderer.set_plan(budgeted);
     const Accel& planned = renderer.structure(automatic);
     row.plan = *planned.ls_plan;
     log("2l-ls:auto at " + mb(row.budget) + " MB: " + mb(planned.bytes_ls()) + " MB, plan in " + fixed(row.plan.seconds, 2) + " s");
@@ -87,7 +87,7 @@ BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, 
     renderer.release(automatic);
     study.rows.push_back(row);
   }
-  renderer.set_ls_options(ls);
+  renderer.set_plan(plan);
   return study;
 }
 

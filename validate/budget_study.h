@@ -47,7 +47,7 @@ struct BudgetStudy {
 };
 
 BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, const std::vector<StructureSpec>& uniform,
-                             const ImageSettings& settings, const LsOptions& ls, const Log& log);
+                             const ImageSettings& settings, const LsPlanOptions& plan, const Log& log);
 
 // budget.md (both tables), budget.csv (the first), budget.json into dir.
 void write_budget_study(const std::string& dir, const BudgetStudy& study);

@@ -55,7 +55,7 @@ CrossCheckResult compare_candidate_arrays(const Accel& cpu, const Accel& gpu, si
     note(r, max_listed, "layout", std::to_string(cpu.ls_nodes.size()) + " LS nodes", std::to_string(gpu.ls_nodes.size()) + " LS nodes");
     return r;
   }
-  lsk::TraceContext c = cpu.context(), g = gpu.context();
+  lsk::TraceContext c = trace_context(cpu), g = trace_context(gpu);  // candidates: no lookup
   for (size_t i = 0; i < cpu.ls_nodes.size(); ++i) {
     const lsk::LsNode& a = cpu.ls_nodes[i];
     const lsk::LsNode& b = gpu.ls_nodes[i];
@@ -112,15 +112,16 @@ CrossCheckResult cross_check_candidates(const gpu::VulkanContext& context, const
 }
 
 CrossCheckResult cross_check_hits(const gpu::VulkanContext& context, const Scene& scene, const StructureSpec& spec,
-                                  const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options) {
+                                  const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options,
+                                  const LsLookup& lookup) {
   const Accel accel = build_planned_accel(scene, spec, options);
   std::vector<lsk::Hit> cpu(rays.size());
   lsk::LsCounters cpu_counters{}, gpu_counters{};
-  trace_rays(accel, rays.data(), cpu.data(), rays.size(), any_hit, &cpu_counters);
+  trace_rays(accel, lookup, rays.data(), cpu.data(), rays.size(), any_hit, &cpu_counters);
   gpu::GpuAccel uploaded(context, accel);
   gpu::GpuTracer tracer(context);
   tracer.set_rays(rays);
-  const std::vector<lsk::Hit> gpu = tracer.trace(uploaded, any_hit, accel.spec.line_space() ? &gpu_counters : nullptr);
+  const std::vector<lsk::Hit> gpu = tracer.trace(uploaded, lookup, any_hit, accel.spec.line_space() ? &gpu_counters : nullptr);
   return compare_hit_arrays(cpu, gpu, cpu_counters, gpu_counters);
 }
 
@@ -161,8 +162,8 @@ int run_candidates_command(const CrossCheckCommand& command, const AccelOptions&
   return r.ok() ? 0 : 1;
 }
 
-int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options) {
-  check_ray_budget("hits", command.rays, command.count, 2, options.ls.max_memory);  // the CPU's hits and the GPU's
+int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options, const LsLookup& lookup) {
+  check_ray_budget("hits", command.rays, command.count, 2, options.limits.max_memory);  // the CPU's hits and the GPU's
   const Scene scene = command_scene(command);
   const StructureSpec spec = parse_structure(command.structure);
   std::vector<lsk::Ray> rays;
@@ -174,7 +175,7 @@ int run_hits_command(const CrossCheckCommand& command, const AccelOptions& optio
   }
   if (rays.empty()) throw InputError("hits: no rays to trace");
   const gpu::VulkanContext context(command.device);
-  const CrossCheckResult r = cross_check_hits(context, scene, spec, rays, command.any_hit, options);
+  const CrossCheckResult r = cross_check_hits(context, scene, spec, rays, command.any_hit, options, lookup);
   print_cross_check(stdout, std::string("hits (") + (command.any_hit ? "any hit" : "closest hit") + "), " + label(command, context) +
                                 " (rays)", r);
   return r.ok() ? 0 : 1;

@@ -39,7 +39,8 @@ CrossCheckResult cross_check_candidates(const gpu::VulkanContext& context, const
 // Builds the structure once (CPU candidates, so a candidate difference cannot hide a traversal one)
 // and traces the rays on both back ends.
 CrossCheckResult cross_check_hits(const gpu::VulkanContext& context, const Scene& scene, const StructureSpec& spec,
-                                  const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options = {});
+                                  const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options = {},
+                                  const LsLookup& lookup = {});
 
 // "what: N compared, M mismatches" and the first mismatches, one per line.
 void print_cross_check(std::FILE* out, const std::string& what, const CrossCheckResult& result);
@@ -59,6 +60,6 @@ struct CrossCheckCommand {
 };
 // Print the counts and first mismatches; return 0 when identical, 1 otherwise (InputError: bad input).
 int run_candidates_command(const CrossCheckCommand& command, const AccelOptions& options);
-int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options);
+int run_hits_command(const CrossCheckCommand& command, const AccelOptions& options, const LsLookup& lookup);
 
 }  // namespace ls::validate

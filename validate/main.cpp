@@ -207,14 +207,20 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  // The image settings of the studies, with the Line Space lookup of --ls-angle and --ls-behind.
+  const auto image_settings = [&] {
+    ImageSettings s = image_flags.settings();
+    s.lookup = ls_flags.lookup();
+    return s;
+  };
   try {
     const ThreadLimit threads(threads_flag.threads);  // first: a bad count is refused before any work
     for (size_t i = 0; i < check_offset.size() && i < 3; ++i) check.offset[i] = check_offset[i];
     if (*candidates_cmd) return validate::run_candidates_command(check, ls_flags.options());
-    if (*hits_cmd) return validate::run_hits_command(check, ls_flags.options());
+    if (*hits_cmd) return validate::run_hits_command(check, ls_flags.options(), ls_flags.lookup());
     if (*rmse_cmd) {
       const std::vector<StructureSpec> specs = parse_structure_list(structures);
-      const ImageSettings settings = image_flags.settings();
+      const ImageSettings settings = image_settings();
       const Scene scene = load_scene(scene_spec);
       auto renderer = make_study_renderer(device, scene, ls_flags.options());
       const RmseStudy study = run_rmse_study(*renderer, scene_spec, specs, settings, out_dir, heatmap_max, log_line);
@@ -230,11 +236,11 @@ int main(int argc, char** argv) {
       grid.subdivisions = parse_int_list(subdivisions, "--subdivisions", 1, kMaxLsSubdivision);
       grid.angles = parse_angle_list(angles);
       grid.start_bounce = start_bounce;
-      const ImageSettings settings = image_flags.settings();
+      const ImageSettings settings = image_settings();
       const Scene scene = load_scene(scene_spec);
       const AccelOptions accel_options = ls_flags.options();
       auto renderer = make_study_renderer(device, scene, accel_options);
-      const Sweep sweep = run_sweep(*renderer, scene_spec, grid, settings, accel_options.ls, log_line);
+      const Sweep sweep = run_sweep(*renderer, scene_spec, grid, settings, log_line);
       write_sweep(out_dir, sweep);
       std::printf("%s\nwrote %s/{sweep.csv, sweep.json, sweep.md}\n", sweep.table().markdown().c_str(), out_dir.c_str());
       if (!no_plot) {
@@ -243,18 +249,18 @@ int main(int argc, char** argv) {
       }
     } else if (*budget_cmd) {
       const std::vector<StructureSpec> specs = parse_structure_list(uniform);
-      const ImageSettings settings = image_flags.settings();
+      const ImageSettings settings = image_settings();
       const Scene scene = load_scene(scene_spec);
       const AccelOptions accel_options = ls_flags.options();
       auto renderer = make_study_renderer(device, scene, accel_options);
-      const BudgetStudy study = run_budget_study(*renderer, scene_spec, specs, settings, accel_options.ls, log_line);
+      const BudgetStudy study = run_budget_study(*renderer, scene_spec, specs, settings, accel_options.plan, log_line);
       write_budget_study(out_dir, study);
       std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\n%s\nwrote %s/{budget.md, budget.csv, budget.json}\n", scene_spec.c_str(),
                   settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
                   study.table().markdown().c_str(), study.choices().markdown().c_str(), out_dir.c_str());
     } else if (*policy_cmd) {
       const StructureSpec spec = parse_structure(policy_structure);
-      const ImageSettings settings = image_flags.settings();
+      const ImageSettings settings = image_settings();
       std::vector<int> starts;
       if (start_bounces.empty())
         for (int k = 1; k <= settings.bounces; ++k) starts.push_back(k);
@@ -272,7 +278,7 @@ int main(int argc, char** argv) {
       const std::vector<StructureSpec> specs = parse_structure_list(bound_structures);
       AccelOptions accel_options = ls_flags.options();
       accel_options.fast_path = false;
-      check_ray_budget("bound", bound_rays, bound_count, 1, accel_options.ls.max_memory);
+      check_ray_budget("bound", bound_rays, bound_count, 1, accel_options.limits.max_memory);
       const Scene scene = load_scene(scene_spec);
       std::vector<lsk::Ray> rays;
       std::string rays_name = bound_rays;
@@ -283,7 +289,7 @@ int main(int argc, char** argv) {
       } else {
         rays = read_rays(bound_rays);
       }
-      const BoundStudy study = run_bound_study(scene, scene_spec, rays, rays_name, specs, accel_options, log_line);
+      const BoundStudy study = run_bound_study(scene, scene_spec, rays, rays_name, specs, accel_options, ls_flags.lookup(), log_line);
       write_bound_study(out_dir, study);
       std::printf("%s, %zu rays (%s); work a ray in box tests (+ %.1f a triangle test, %.1f a lookup), reference kernels\n\n%s\n"
                   "wrote %s/{bound.md, bound.csv, bound.json}\n",
@@ -294,7 +300,7 @@ int main(int argc, char** argv) {
       options.scenes = scene_list(scenes);
       options.tables = int_set(tables, "--tables", 2, 4);
       options.subdivisions = int_set(paper_n, "--subdivisions", 6, 10);
-      options.settings = image_flags.settings();
+      options.settings = image_settings();
       options.device = device;
       options.heatmap_max = heatmap_max;
       const PaperReport report = run_paper(options, ls_flags.options(), out_dir, log_line);

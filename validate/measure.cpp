@@ -13,6 +13,7 @@ RenderOptions ImageSettings::options(const Schedule& schedule) const {
   o.spp = spp;
   o.bounces = bounces;
   o.seed = seed;
+  o.lookup = lookup;
   return o;
 }
 

@@ -19,6 +19,7 @@ struct ImageSettings {
   int spp = 4;
   int bounces = 3;
   uint32_t seed = 1;
+  LsLookup lookup;  // --ls-angle, --ls-behind: every render's Line Space lookups
   RenderOptions options(const Schedule& schedule) const;
 };
 

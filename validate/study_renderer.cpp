@@ -31,10 +31,10 @@ RenderResult StudyRenderer::render(const RenderOptions& options) {
   return backend_->render(scene_, built_, options, {});
 }
 
-void StudyRenderer::set_ls_options(const LsOptions& options) {
-  options_.ls = options;
+void StudyRenderer::set_plan(const LsPlanOptions& plan) {
+  options_.plan = plan;
   for (auto it = built_.begin(); it != built_.end();)
-    it = it->second.spec.line_space() ? built_.erase(it) : std::next(it);
+    it = it->second.spec.budgeted ? built_.erase(it) : std::next(it);
 }
 
 std::unique_ptr<StudyRenderer> make_cpu_study_renderer(const Scene& scene, const AccelOptions& options) {

@@ -27,8 +27,8 @@ class StudyRenderer {
   RenderResult render(const RenderOptions& options);
   // Frees a structure no later render needs (sweeps over many Line Spaces).
   void release(const StructureSpec& spec) { built_.erase(spec.name()); }
-  // New Line Space options (a sweep over the refusal angle): built Line Spaces are dropped.
-  void set_ls_options(const LsOptions& options);
+  // New 2l-ls:auto planner options (the budget study): a built 2l-ls:auto structure is dropped.
+  void set_plan(const LsPlanOptions& plan);
 
  private:
   std::unique_ptr<Backend> backend_;

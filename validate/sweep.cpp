@@ -114,7 +114,7 @@ nlohmann::json Sweep::json() const {
 }
 
 Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings,
-                const LsOptions& base_options, const Log& log) {
+                const Log& log) {
   if (grid.start_bounce < 1 || grid.start_bounce > settings.bounces)
     throw InputError("--start-bounce " + std::to_string(grid.start_bounce) + " must be in [1, --bounces " +
                      std::to_string(settings.bounces) + "]");
@@ -131,9 +131,8 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
   const size_t total = grid.angles.size() * grid.families.size() * grid.depths.size() * grid.subdivisions.size();
   size_t done = 0;
   for (float angle : grid.angles) {
-    LsOptions options = base_options;
-    options.angle_degrees = angle;
-    renderer.set_ls_options(options);
+    ImageSettings at_angle = settings;  // the angle is the lookup's: the structures stay built
+    at_angle.lookup.angle_degrees = angle;
     for (StructureKind family : grid.families)
       for (int depth : grid.depths)
         for (int n : grid.subdivisions) {
@@ -157,7 +156,7 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
             p.refused = e.what();
           }
           if (p.refused.empty()) {
-            const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), settings, reference);
+            const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), at_angle, reference);
             p.rmse = m.rmse;
             p.mrays_per_s = m.mrays_per_s;
             p.speedup = sweep.reference_mrays_per_s > 0.0 ? m.mrays_per_s / sweep.reference_mrays_per_s : 0.0;

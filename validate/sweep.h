@@ -49,8 +49,7 @@ std::vector<int> parse_int_list(const std::string& text, const std::string& flag
 std::vector<float> parse_angle_list(const std::string& text);
 std::vector<StructureKind> parse_families(const std::string& text);
 
-Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings,
-                const LsOptions& base_options, const Log& log);
+Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings, const Log& log);
 // The exact reference (RMSE 0 at reference_mrays_per_s) takes part: a point it dominates is off the front.
 void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s);
 

@@ -11,6 +11,11 @@
 
 namespace ls {
 
+// What a command may hold: --max-memory.
+struct Limits {
+  size_t max_memory = 0;  // bytes; 0: half of the physical memory (memory_budget)
+};
+
 size_t physical_memory_bytes();
 
 // max_memory in bytes, or half of the physical memory when 0.

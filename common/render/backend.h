@@ -25,14 +25,15 @@ class Backend {
   // `build`: builds and prints the structure (DESIGN §9 keys), with what this backend adds.
   virtual void print_build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options, bool json) = 0;
   // `trace`: hits and Line Space counters (added to *counters); `timing` says how long, for the log line.
-  virtual std::vector<lsk::Hit> trace(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit,
-                                      lsk::LsCounters* counters, std::string* timing) = 0;
+  virtual std::vector<lsk::Hit> trace(const Accel& accel, const LsLookup& lookup, const std::vector<lsk::Ray>& rays,
+                                      bool any_hit, lsk::LsCounters* counters, std::string* timing) = 0;
   virtual RenderResult render(const Scene& scene, const std::map<std::string, Accel>& structures,
                               const RenderOptions& options, const Progress& progress) = 0;
   // `bench`: times and prints (text or JSON); embree_isa: Embree's instruction set where the backend
   // runs Embree beside its structures (embree_tracer.h).
   virtual void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs,
-                     int repeats, const AccelOptions& options, bool any_hit, const std::string& embree_isa, bool json) = 0;
+                     int repeats, const AccelOptions& options, const LsLookup& lookup, bool any_hit,
+                     const std::string& embree_isa, bool json) = 0;
   // `render --frames` (render_frames.h): brings a two-level structure made by build() to a posed scene
   // by its top level alone (top_level_update.h).  A backend with a device copy of the structure
   // refreshes that copy's top level here, and nothing else of it.

@@ -43,10 +43,10 @@ std::vector<std::pair<std::string, std::string>> render_identity(const PartialHe
           {"throughput_switch", h.throughput_switch}};
 }
 
-std::string ls_flags_text(const LsOptions& o) {
-  return "angle=" + float_text(o.angle_degrees) + " further_rays=" + std::to_string(o.further_rays) +
+std::string ls_flags_text(const LsBuildOptions& o, const LsLookup& lookup) {
+  return "angle=" + float_text(lookup.angle_degrees) + " further_rays=" + std::to_string(o.further_rays) +
          " min_triangles=" + std::to_string(o.min_triangles) + " candidates=" + (o.paper_candidates ? "paper" : "compact") +
-         " behind=" + (o.reverse_behind ? "reverse" : "exact");
+         " behind=" + (lookup.reverse_behind ? "reverse" : "exact");
 }
 
 std::string partial_stem(const std::string& selection) {

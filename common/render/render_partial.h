@@ -42,7 +42,7 @@ struct PartialHeader {
 std::vector<std::pair<std::string, std::string>> render_identity(const PartialHeader& header);
 
 // The Line Space flags that change images, as one text ("angle=45 further_rays=0 ...").
-std::string ls_flags_text(const LsOptions& options);
+std::string ls_flags_text(const LsBuildOptions& options, const LsLookup& lookup);
 
 // "--shard 1/3" -> "partial-shard-1-of-3", "--tiles 0:5" -> "partial-tiles-0-5": the partial's file
 // name without extension, unique per selection so shards can share one folder.

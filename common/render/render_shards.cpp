@@ -28,12 +28,13 @@ ShardChoice choose_tiles(const std::string& tiles, const std::string& shard, uin
 }
 
 std::string write_shard_outputs(const std::string& dir, const ShardChoice& choice, const Scene& scene,
-                                const RenderResult& result, const RenderReportContext& context, const LsOptions& ls) {
+                                const RenderResult& result, const RenderReportContext& context, const LsBuildOptions& ls,
+                                const LsLookup& lookup) {
   PartialHeader h;
   h.scene = context.scene;
   h.scene_fingerprint = fingerprint_text(scene_fingerprint(scene));
   h.schedule = context.schedule;
-  h.ls_flags = ls_flags_text(ls);
+  h.ls_flags = ls_flags_text(ls, lookup);
   h.throughput_switch = context.throughput_switch.name();
   h.selection = choice.selection;
   h.spp = context.spp;

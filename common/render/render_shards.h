@@ -30,7 +30,8 @@ ShardChoice choose_tiles(const std::string& tiles, const std::string& shard, uin
 // Writes DIR/<stem>.exr (the partial) and DIR/<stem>.json (its report: render_report's keys plus
 // tile_size, tiles and selection), stem = partial_stem(selection); returns DIR/<stem>.
 std::string write_shard_outputs(const std::string& dir, const ShardChoice& choice, const Scene& scene,
-                                const RenderResult& result, const RenderReportContext& context, const LsOptions& ls);
+                                const RenderResult& result, const RenderReportContext& context, const LsBuildOptions& ls,
+                                const LsLookup& lookup);
 
 // `merge`: merges the partials and writes total.exr, bounce_K.exr, image.png and report.json into dir.
 void merge_render_outputs(const std::string& dir, const std::vector<std::string>& partials);

@@ -17,6 +17,7 @@ namespace ls {
 
 struct RenderOptions {
   Schedule schedule;
+  LsLookup lookup;  // every Line Space lookup of the render (the angle, the behind mode)
   int spp = 16;
   int bounces = 3;  // indirect segments after the primary hit
   uint32_t width = 512;

@@ -31,23 +31,27 @@ size_t Accel::bytes_total() const {
          top_nodes.size() * sizeof(lsk::BvhNode) + instances.size() * sizeof(lsk::InstanceRecord) + bytes_ls();
 }
 
-lsk::TraceContext Accel::context() const {
+float ls_cos2(const LsLookup& lookup) {
+  const double a = double(lookup.angle_degrees) * 3.14159265358979323846 / 180.0;
+  return lookup.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
+}
+
+lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
   lsk::TraceContext c;
-  c.nodes = nodes.data();
-  c.tris = tris.data();
-  c.tri_ids = tri_ids.data();
-  c.tri_instances = tri_instances.data();
-  c.top_nodes = top_nodes.data();
-  c.instances = instances.data();
-  if (spec.line_space() && !node_ls.empty()) {  // laid out (a 2l-ls:auto plan traces before it has one)
-    c.node_ls = node_ls.data();
-    c.ls_nodes = ls_nodes.data();
-    c.ls_candidates = ls_candidates.data();
-    c.tri_normals = tri_normals.data();
+  c.nodes = accel.nodes.data();
+  c.tris = accel.tris.data();
+  c.tri_ids = accel.tri_ids.data();
+  c.tri_instances = accel.tri_instances.data();
+  c.top_nodes = accel.top_nodes.data();
+  c.instances = accel.instances.data();
+  if (accel.spec.line_space() && !accel.node_ls.empty()) {  // laid out (a 2l-ls:auto plan traces before it has one)
+    c.node_ls = accel.node_ls.data();
+    c.ls_nodes = accel.ls_nodes.data();
+    c.ls_candidates = accel.ls_candidates.data();
+    c.tri_normals = accel.tri_normals.data();
     c.ls_enabled = 1;
-    const double a = double(ls_options.angle_degrees) * 3.14159265358979323846 / 180.0;
-    c.ls_cos2 = ls_options.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
-    c.ls_reverse = ls_options.reverse_behind ? 1u : 0u;
+    c.ls_cos2 = ls_cos2(lookup);
+    c.ls_reverse = lookup.reverse_behind ? 1u : 0u;
   }
   return c;
 }

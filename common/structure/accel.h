@@ -5,6 +5,7 @@
 // reverse; the CPU's fast path (cpu/trace/fast_tracer.h) hangs off an Accel as an opaque pointer.
 #pragma once
 
+#include "common/base/memory_budget.h"
 #include "common/kernels/layouts.h"
 #include "common/model/scene.h"
 #include "common/model/structure_name.h"
@@ -42,22 +43,31 @@ struct ObjectLs {
   bool operator==(const ObjectLs&) const = default;
 };
 
-struct LsOptions {
-  // Defaults chosen by measurement: see README, "Line Space parameters".
+// What building a Line Space reads (F-LS, 2L-LS).  Defaults chosen by measurement: see
+// docs/performance.md, "Line Space parameters".
+struct LsBuildOptions {
   int further_rays = 0;          // search rays after the midpoint ray
-  float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
-  bool reverse_behind = false;   // --ls-behind reverse: a plane hit behind the origin asks the reverse shaft (ls_lookup.h)
   uint32_t min_triangles = 8;    // subtrees with fewer triangles get no LS (0: the paper's behaviour)
   bool paper_candidates = false; // 4-byte candidates instead of the compact 1/2/4-byte local index
-  size_t max_memory = 0;         // refuse above this estimate (0: half of physical memory)
   // Per mesh (2L only): each object's own D and N, overriding the structure's; empty: the
-  // structure's D and N for every object.  2l-ls:auto fills it from the budget (ls_budget.h).
+  // structure's D and N for every object.  2l-ls:auto's plan fills it (cpu/build/ls_budget.h).
   std::vector<ObjectLs> objects;
-  // 2l-ls:auto (ls_budget.h): bytes of Line Space to spend (bytes_ls), and the pilot's rays.
-  size_t budget = 0;
-  size_t budget_rays = 1u << 15;
   // Called now and then from the building threads with (LS nodes done, LS nodes): a progress bar.
   std::function<void(size_t done, size_t total)> progress;
+};
+
+// What a Line Space lookup reads besides the structure: it travels with each trace and render call
+// (trace_rays, RenderOptions::lookup), so changing it never rebuilds a Line Space.
+struct LsLookup {
+  float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
+  bool reverse_behind = false;   // --ls-behind reverse: a plane hit behind the origin asks the reverse shaft (ls_lookup.h)
+};
+
+// 2l-ls:auto's planner inputs (cpu/build/ls_budget.h).
+struct LsPlanOptions {
+  size_t budget = 0;             // bytes of Line Space to spend (bytes_ls); 0: none given
+  size_t rays = 1u << 15;        // the pilot's diffuse rays
+  LsLookup lookup;               // the lookup the plan's error and work are measured with
 };
 
 struct LsBuildInfo {
@@ -109,7 +119,7 @@ struct LsPlan {
   double seconds = 0.0;
   std::vector<LsPlanRow> rows;  // every object the structure holds, by mesh index
 
-  std::vector<ObjectLs> objects(size_t meshes) const;  // LsOptions::objects of the plan
+  std::vector<ObjectLs> objects(size_t meshes) const;  // LsBuildOptions::objects of the plan
 };
 
 struct Accel {
@@ -138,7 +148,7 @@ struct Accel {
   std::vector<lsk::LsNode> ls_nodes;
   std::vector<uint32_t> ls_candidates;      // packed per LsNode
   std::vector<glm::uvec4> tri_normals;      // octahedral vertex normals per triangle (BVH order)
-  LsOptions ls_options;
+  LsBuildOptions ls_options;              // what its Line Space was built with
   LsBuildInfo ls_info;
   std::shared_ptr<const LsPlan> ls_plan;    // 2l-ls:auto: the per-object choice (ls_budget.h)
 
@@ -152,12 +162,13 @@ struct Accel {
   size_t fast_bytes = 0;                    // FastTracer::bytes() of `fast`, set wherever it is made
   size_t bytes_wide() const { return fast_bytes; }  // the fast path's wide nodes (beside bytes_total)
   size_t bytes_ls() const;
-  lsk::TraceContext context() const;
 };
 
 struct AccelOptions {
   BvhBuildOptions bvh;
-  LsOptions ls;
+  LsBuildOptions ls;
+  LsPlanOptions plan;             // 2l-ls:auto only
+  Limits limits;                  // --max-memory: builds refuse what would not fit
   bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
   Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
   int wide_width = 4;                     // treelets (Line Space structures): 4 or 8, chosen by measurement
@@ -169,5 +180,12 @@ struct AccelOptions {
 
 // Sums Line Space lookup counters.
 void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from);
+
+// The kernels' view of a built structure's buffers, with the lookup's parameters (the refusal angle's
+// cos^2, the behind mode).
+lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup = {});
+
+// The kernels' ls_cos2 of a lookup: cos^2 of the refusal angle, negative (refuse all) at 0 degrees.
+float ls_cos2(const LsLookup& lookup);
 
 }  // namespace ls

@@ -18,7 +18,7 @@
 namespace ls {
 
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats, const AccelOptions& options, bool any_hit, const std::string& embree_isa) {
+                      int repeats, const AccelOptions& options, const LsLookup& lookup, bool any_hit, const std::string& embree_isa) {
   BenchResult result;
   result.rays = rays.size();
   result.threads = thread_count();
@@ -32,9 +32,9 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   // The rays, a hit array, the structures and Embree's scene stay in memory together for the timed
   // runs: each structure, then Embree, is refused over what the ones before it left of the budget
   // (memory_budget.h), so that together they stay within it.
-  const size_t budget = memory_budget(options.ls.max_memory);
+  const size_t budget = memory_budget(options.limits.max_memory);
   size_t held = ray_bytes(rays.size(), false, 1);  // then the structures built so far, fast paths included
-  check_held_budget("bench: " + std::to_string(rays.size()) + " rays and their hits", held, options.ls.max_memory,
+  check_held_budget("bench: " + std::to_string(rays.size()) + " rays and their hits", held, options.limits.max_memory,
                     "use fewer rays (--count) or raise --max-memory");
   std::vector<Accel> built;
   for (const StructureSpec& spec : structures) {
@@ -43,7 +43,7 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
                                 ": bench fewer --structures or raise --max-memory";
     if (held >= budget) throw InputError(held_by);
     AccelOptions left = options;
-    left.ls.max_memory = budget - held;
+    left.limits.max_memory = budget - held;
     try {
       built.push_back(build_planned_accel(scene, spec, left));
     } catch (const InputError& e) {
@@ -71,10 +71,10 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   for (const Accel& accel : built) {
     // Occlusion queries (rtcOccluded1's kind) on the fast path; the reference keeps its any hit.
     if (any_hit)
-      runs.push_back([&] { trace_occlusion(accel, rays.data(), hits.data(), rays.size(), nullptr, Traversal::Fast); });
+      runs.push_back([&] { trace_occlusion(accel, lookup, rays.data(), hits.data(), rays.size(), nullptr, Traversal::Fast); });
     else
-      runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), false, nullptr, Traversal::Fast); });
-    runs.push_back([&] { trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, Traversal::Reference); });
+      runs.push_back([&] { trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), false, nullptr, Traversal::Fast); });
+    runs.push_back([&] { trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), any_hit, nullptr, Traversal::Reference); });
   }
   runs.push_back([&] { embree.trace(rays.data(), hits.data(), rays.size(), any_hit); });
 

@@ -44,7 +44,7 @@ struct BenchResult {
 // any_hit: occlusion queries (rtcOccluded1 for Embree), e.g. for shadow rays.  embree_isa: one of
 // embree_isa_names() (embree_tracer.h).
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
-                      int repeats, const AccelOptions& options = {}, bool any_hit = false,
+                      int repeats, const AccelOptions& options = {}, const LsLookup& lookup = {}, bool any_hit = false,
                       const std::string& embree_isa = "best");
 
 

@@ -49,14 +49,14 @@ struct ThreadsFlag {
 
 // Line Space options shared by every subcommand that builds a structure.
 struct LsFlags {
-  double angle = LsOptions{}.angle_degrees;
-  int further_rays = LsOptions{}.further_rays;
-  uint32_t min_triangles = LsOptions{}.min_triangles;
+  double angle = LsLookup{}.angle_degrees;
+  int further_rays = LsBuildOptions{}.further_rays;
+  uint32_t min_triangles = LsBuildOptions{}.min_triangles;
   std::string candidates = "compact";
   std::string behind = "exact";
   double max_memory_mb = 0.0;
   double ls_budget_mb = 0.0;
-  size_t ls_budget_rays = LsOptions{}.budget_rays;
+  size_t ls_budget_rays = LsPlanOptions{}.rays;
   bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
   std::string traversal = "fast";
   int wide_width = AccelOptions{}.wide_width;
@@ -97,19 +97,25 @@ struct LsFlags {
     app->add_option("--ls-budget-rays", ls_budget_rays, "2l-ls:auto: pilot diffuse rays that measure each object's error")
         ->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 24));
   }
+  // --ls-angle and --ls-behind: what every lookup of a trace or render reads (no build does).
+  LsLookup lookup() const {
+    LsLookup l;
+    l.angle_degrees = float(angle);
+    l.reverse_behind = behind == "reverse";
+    return l;
+  }
   AccelOptions options() const {
     for (const auto& [name, flag] : refused_flags)
       if (flag->count() > 0)
         throw InputError(name + " is a flag of linespace-cpu's fast path; this command traces with the shared kernels");
     AccelOptions o;
-    o.ls.angle_degrees = float(angle);
-    o.ls.reverse_behind = behind == "reverse";
     o.ls.further_rays = further_rays;
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
-    o.ls.max_memory = size_t(max_memory_mb * 1e6);
-    o.ls.budget = size_t(ls_budget_mb * 1e6);
-    o.ls.budget_rays = ls_budget_rays;
+    o.limits.max_memory = size_t(max_memory_mb * 1e6);
+    o.plan.budget = size_t(ls_budget_mb * 1e6);
+    o.plan.rays = ls_budget_rays;
+    o.plan.lookup = lookup();  // 2l-ls:auto measures its plan with the lookup the renders use
     o.traversal = parse_traversal(traversal);
     o.wide_width = wide_width;
     o.exact_width = exact_width;

@@ -163,6 +163,7 @@ RenderOptions render_options(const Values& v) {
   options.spp = v.spp;
   options.bounces = v.bounces;
   options.seed = v.seed;
+  options.lookup = v.ls.lookup();
   if (!v.throughput_switch.empty()) options.throughput_switch = parse_throughput_switch(v.throughput_switch);
   return options;
 }
@@ -200,7 +201,7 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   }
   RenderOptions options = render_options(v);
   const AccelOptions accel_options = v.ls.options();
-  check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
+  check_render_budget(options.width, options.height, options.bounces, accel_options.limits.max_memory);
   const ShardChoice shard = choose_tiles(v.tiles, v.shard, v.tile_size, options.width, options.height);
   if (shard.sharded()) options.pixels = tile_pixels(shard.grid, shard.tiles);  // a shard: only its tiles
   std::map<std::string, Accel> built;
@@ -214,7 +215,7 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   const std::string device = backend.device();
   RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr, policy};
   if (shard.sharded()) {
-    const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls);
+    const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls, options.lookup);
     std::printf("wrote %s.{exr, json} (a partial for merge): %zu of the image's %s\n", stem.c_str(), shard.tiles.size(),
                 shard.grid.describe().c_str());
   } else {
@@ -240,7 +241,7 @@ void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v)
 
 // The rays a command holds, refused over the budget before the scene is loaded or a ray made.
 void check_ray_budgets(const Commands& c, const Values& v) {
-  const size_t max_memory = v.ls.options().ls.max_memory;
+  const size_t max_memory = v.ls.options().limits.max_memory;
   if (*c.rays) check_ray_budget("rays", "", v.count, 0, max_memory);
   if (*c.trace) check_ray_budget("trace", v.rays_path, 0, 1, max_memory);
   if (*c.bench) check_ray_budget("bench", v.rays_path, v.count, 1, max_memory);
@@ -277,7 +278,7 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
     const std::vector<lsk::Ray> in = read_rays(v.rays_path);
     lsk::LsCounters counters{};
     std::string timing;
-    const std::vector<lsk::Hit> out = backend->trace(accel, in, v.any_hit, &counters, &timing);
+    const std::vector<lsk::Hit> out = backend->trace(accel, v.ls.lookup(), in, v.any_hit, &counters, &timing);
     if (accel.spec.line_space()) print_counters(counters);
     write_hits(v.hits_path, out);
     size_t found = 0;
@@ -291,7 +292,7 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
     const std::vector<lsk::Ray> rays = v.rays_path.empty() ? make_rays(scene, v.bench_kind, v.count, v.seed) : read_rays(v.rays_path);
     if (rays.empty()) throw InputError("bench: the ray file holds no rays");
     const bool occlusion = v.bench_any_hit || (v.rays_path.empty() && v.bench_kind == "shadow");
-    backend->bench(scene, rays, specs, v.repeats, v.ls.options(), occlusion, v.embree_isa, v.json);
+    backend->bench(scene, rays, specs, v.repeats, v.ls.options(), v.ls.lookup(), occlusion, v.embree_isa, v.json);
   }
 }
 

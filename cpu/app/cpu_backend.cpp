@@ -77,13 +77,13 @@ class CpuBackend : public Backend {
   }
   // With --traversal reference the log line adds the kernels' work counts (the 2l-ls:auto work model
   // is fitted to them: README, "2l-ls:auto").
-  std::vector<lsk::Hit> trace(const Accel& accel, const std::vector<lsk::Ray>& rays, bool any_hit, lsk::LsCounters* counters,
-                              std::string* note) override {
+  std::vector<lsk::Hit> trace(const Accel& accel, const LsLookup& lookup, const std::vector<lsk::Ray>& rays, bool any_hit,
+                              lsk::LsCounters* counters, std::string* note) override {
     std::vector<lsk::Hit> hits(rays.size());
     TraceWorkTotals work;
     const bool reference = accel.traversal == Traversal::Reference;
     const std::vector<uint8_t> ls_subtrees = reference ? line_space_subtrees(accel) : std::vector<uint8_t>();
-    trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, counters, accel.traversal, reference ? &work : nullptr,
+    trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), any_hit, counters, accel.traversal, reference ? &work : nullptr,
                &ls_subtrees);
     if (reference && note) {
       *note = "; reference work: " + std::to_string(work.box_tests) + " box tests, " + std::to_string(work.triangle_tests) +
@@ -99,8 +99,9 @@ class CpuBackend : public Backend {
     return ls::render(scene, structures, options, progress);
   }
   void bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& specs, int repeats,
-             const AccelOptions& options, bool any_hit, const std::string& embree_isa, bool json) override {
-    print_bench(run_bench(scene, rays, specs, repeats, options, any_hit, embree_isa), json);
+             const AccelOptions& options, const LsLookup& lookup, bool any_hit, const std::string& embree_isa,
+             bool json) override {
+    print_bench(run_bench(scene, rays, specs, repeats, options, lookup, any_hit, embree_isa), json);
   }
   TopLevelUpdate update_top_level(const Scene& posed, Accel& accel, TopLevelMode mode) override {
     return ls::update_top_level(posed, accel, mode);

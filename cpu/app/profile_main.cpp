@@ -40,6 +40,7 @@ int main(int argc, char** argv) try {
   enum class Path { Fast, Reference, Embree } path = Path::Fast;
   enum class Query { Closest, AnyHit, Occlusion } query = Query::Closest;
   ls::AccelOptions options;
+  ls::LsLookup lookup;
   std::string embree_isa = "best";  // valgrind 3.19 has no AVX-512: under it, "best" is Embree's avx2
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
@@ -51,7 +52,7 @@ int main(int argc, char** argv) try {
     else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
     else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
     else if (a == "--ls-behind" && i + 1 < argc && (std::string(argv[i + 1]) == "exact" || std::string(argv[i + 1]) == "reverse"))
-      options.ls.reverse_behind = std::string(argv[++i]) == "reverse";
+      lookup.reverse_behind = std::string(argv[++i]) == "reverse";
     else if (a == "--exact-width" && i + 1 < argc) options.exact_width = std::atoi(argv[++i]);  // 4 or 8, else InputError
     else return usage();
   }
@@ -71,9 +72,9 @@ int main(int argc, char** argv) try {
     accel = ls::build_planned_accel(scene, ls::parse_structure(argv[2]), options);
     const ls::Traversal traversal = path == Path::Fast ? ls::Traversal::Fast : ls::Traversal::Reference;
     if (query == Query::Occlusion)
-      run = [&] { ls::trace_occlusion(accel, rays.data(), hits.data(), rays.size(), nullptr, traversal); };
+      run = [&] { ls::trace_occlusion(accel, lookup, rays.data(), hits.data(), rays.size(), nullptr, traversal); };
     else
-      run = [&] { ls::trace_rays(accel, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal); };
+      run = [&] { ls::trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal); };
   }
   double best = 0.0;
   for (int r = 0; r < repeat; ++r) {

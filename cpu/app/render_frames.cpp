@@ -129,7 +129,7 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
   const SceneRig& rig = scene.rig;
   if (rig.animations.empty() && frames.animation != 0)
     throw InputError(scene_spec + ": --animation " + std::to_string(frames.animation) + ", but the scene has no animation");
-  check_render_budget(options.width, options.height, options.bounces, accel_options.ls.max_memory);
+  check_render_budget(options.width, options.height, options.bounces, accel_options.limits.max_memory);
   const auto time_of = [&](int f) { return double(f) / frames.fps; };
   // Refuses what cannot be posed (a missing animation, weights channels, a singular pose on any frame)
   // before anything is built or said: posing is cheap beside rendering.

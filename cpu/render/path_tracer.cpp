@@ -65,11 +65,11 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
   // of which the render reads only whether they are blocked.
   const BatchTracer trace_batch =
       tracer ? tracer
-             : BatchTracer([](const Accel& a, const lsk::Ray* r, lsk::Hit* h, size_t n, bool any, lsk::LsCounters* c) {
+             : BatchTracer([&options](const Accel& a, const lsk::Ray* r, lsk::Hit* h, size_t n, bool any, lsk::LsCounters* c) {
                  if (any)
-                   trace_occlusion(a, r, h, n, c);
+                   trace_occlusion(a, options.lookup, r, h, n, c);
                  else
-                   trace_rays(a, r, h, n, any, c);
+                   trace_rays(a, options.lookup, r, h, n, any, c);
                });
   const auto start = std::chrono::steady_clock::now();
   const uint32_t pixels = options.width * options.height;

@@ -71,7 +71,7 @@ std::vector<lsk::Ray> generate_rays(const Scene& scene, const Accel& exact, RayK
   // Diffuse: primary rays that hit something, each followed by one cosine-weighted bounce.  Primary
   // rays are drawn in rounds of `count` candidates until enough hit.
   const SurfaceLookup surfaces(scene);
-  const lsk::TraceContext context = exact.context();
+  const lsk::TraceContext context = trace_context(exact);  // exact: no Line Space to look up
   size_t filled = 0;
   for (uint32_t round = 0; filled < count; ++round) {
     if (round >= 64) throw InputError("diffuse rays: the camera sees (almost) nothing of this scene");

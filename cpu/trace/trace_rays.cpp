@@ -19,9 +19,9 @@ lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const l
 }
 
 
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+void trace_rays(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters) {
-  trace_rays(accel, rays, hits, count, any_hit, counters, accel.traversal);
+  trace_rays(accel, lookup, rays, hits, count, any_hit, counters, accel.traversal);
 }
 
 std::vector<uint8_t> line_space_subtrees(const Accel& accel) {
@@ -50,10 +50,10 @@ namespace {
 
 // trace_rays and trace_occlusion: TBB over chunks of rays, each chunk on its own copy of the trace
 // context, counters per thread and summed once.
-void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit, bool occlusion,
+void trace_chunks(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit, bool occlusion,
                   lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work,
                   const std::vector<uint8_t>* ls_subtrees) {
-  lsk::TraceContext context = accel.context();
+  lsk::TraceContext context = trace_context(accel, lookup);
   if (work && ls_subtrees && !ls_subtrees->empty()) context.node_in_ls = ls_subtrees->data();
   const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
   // Per-thread counters, summed once at the end: no lock on the hot path.
@@ -91,19 +91,19 @@ void trace_chunks(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size
 
 }  // namespace
 
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+void trace_rays(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work,
                 const std::vector<uint8_t>* ls_subtrees) {
-  trace_chunks(accel, rays, hits, count, any_hit, false, counters, traversal, work, ls_subtrees);
+  trace_chunks(accel, lookup, rays, hits, count, any_hit, false, counters, traversal, work, ls_subtrees);
 }
 
-void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
+void trace_occlusion(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
                      Traversal traversal) {
-  trace_chunks(accel, rays, hits, count, true, true, counters, traversal, nullptr, nullptr);
+  trace_chunks(accel, lookup, rays, hits, count, true, true, counters, traversal, nullptr, nullptr);
 }
 
-void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters) {
-  trace_occlusion(accel, rays, hits, count, counters, accel.traversal);
+void trace_occlusion(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters) {
+  trace_occlusion(accel, lookup, rays, hits, count, counters, accel.traversal);
 }
 
 }  // namespace ls

@@ -16,9 +16,9 @@ namespace ls {
 lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 
-// Traces a batch on all threads (TBB) with accel.traversal; Line Space counters are added to *counters
+// Traces a batch on all threads (TBB) with accel.traversal, Line Space lookups as `lookup` says; Line Space counters are added to *counters
 // when given.  The second form names the traversal (bench and tests run both on one structure).
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+void trace_rays(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters = nullptr);
 // The reference traversal's work over a batch (the 2l-ls:auto pilot's model, ls_budget.h): box and
 // triangle tests counted by the kernels, Line Space lookups by the counters.  The fast path counts
@@ -40,15 +40,15 @@ inline double work_units(uint64_t box_tests, uint64_t triangle_tests, uint64_t l
 std::vector<uint8_t> line_space_subtrees(const Accel& accel);
 // ls_subtrees (line_space_subtrees of accel): the work done in those subtrees is also counted as
 // work->*_in_ls; without it they stay 0.
-void trace_rays(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
+void trace_rays(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work = nullptr,
                 const std::vector<uint8_t>* ls_subtrees = nullptr);
 
 // Occlusion queries (shadow rays) on all threads: a ray misses exactly where trace_rays' any hit
 // misses; where it is blocked its hit record is *a* hit in [tmin, tmax] (on the fast path not
 // necessarily the reference's first: FastTracer::occluded).  The path tracer's shadow rays use it.
-void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters = nullptr);
-void trace_occlusion(const Accel& accel, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
+void trace_occlusion(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters = nullptr);
+void trace_occlusion(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, lsk::LsCounters* counters,
                      Traversal traversal);
 
 
