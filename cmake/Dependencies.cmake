@@ -1,4 +1,4 @@
-# Every dependency is a Debian package (README lists them).  Traps are in ../shared/TOOLCHAIN.md.
+# Every dependency is a Debian package (scripts/setup.sh installs them).  Their traps: docs/design.md §11.
 find_package(Threads REQUIRED)           # before glslang: its targets use Threads::Threads
 find_package(TBB REQUIRED)
 find_package(glm REQUIRED)

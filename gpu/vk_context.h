@@ -1,4 +1,4 @@
-// The Vulkan instance, the chosen compute device, its queue and a command pool (issue 5, DESIGN §4).
+// The Vulkan instance, the chosen compute device, its queue and a command pool (docs/design.md §4).
 // Device choice: `--device NAME|INDEX` picks one (INDEX in vkEnumeratePhysicalDevices order, NAME a
 // case-insensitive substring of the device name); without it a discrete GPU is preferred, then an
 // integrated or virtual one, then a CPU driver such as Mesa's lavapipe.  No Vulkan loader, no device or

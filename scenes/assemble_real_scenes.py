@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Assembles glTF 2.0 interior scenes resembling the paper's five test scenes from freely licensed
-Debian packages (DESIGN §8): furniture from `sweethome3d-furniture` (CC0 / CC-BY 3.0 OBJ models) and
+Debian packages (docs/design.md §8): furniture from `sweethome3d-furniture` (CC0 / CC-BY 3.0 OBJ models) and
 the bunny from `libcgal-demo`'s data.  Python 3 standard library only; nothing is downloaded.
 
 Each scene is one .glb: one glTF mesh per object (OBJ triangle order kept, polygons fanned), one node

@@ -7,7 +7,7 @@
 //   instances          closed room [-7.5,7.5]x[0,6]x[-7.5,7.5] (6 wall objects), two ceiling lights, an
 //                      8x8 grid of 64 instances of ONE 51,200-triangle torus knot (own rotation and scale,
 //                      every fourth non-uniform) and three unique objects: 12 objects, 75 instances.
-//   carousel           rigid animation (issue 8): the instances room with one ceiling light, a pedestal and a
+//   carousel           rigid animation: the instances room with one ceiling light, a pedestal and a
 //                      sphere (static, unique), 16 instances of one 12,800-triangle torus knot riding a
 //                      carousel (a hub node turning once in 4 s; each knot spinning, every other one bobbing)
 //                      and 8 instances of one 3,968-triangle ball pulsing in scale: 11 objects, 33 instances,

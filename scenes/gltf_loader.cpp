@@ -1,4 +1,4 @@
-// glTF 2.0 (.gltf, .glb) -> ls::Scene (DESIGN §8, ids §9).
+// glTF 2.0 (.gltf, .glb) -> ls::Scene (docs/design.md §8, ids §9).
 //
 // tinygltf parses the JSON and the buffers; it does not check that accessors, buffer views and indices
 // stay inside their buffers, so every range is checked here before a byte is read.  Anything the
@@ -478,7 +478,7 @@ class GltfReader {
     rig_.assign(model_.nodes.size(), RigNode{});
     for (int root : roots()) visit(root, glm::dmat4(1.0), -1, 0);
 
-    // Instance id = rank by node index of the reached mesh-bearing nodes (DESIGN §9).
+    // Instance id = rank by node index of the reached mesh-bearing nodes (docs/design.md §9).
     std::optional<size_t> camera_node;
     for (size_t n = 0; n < model_.nodes.size(); ++n) {
       if (state_[n] != kDone) continue;

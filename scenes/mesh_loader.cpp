@@ -4,7 +4,7 @@
 // readers (the first choice) corrupt the heap on malformed OBJ faces, crash on malformed PLY headers
 // and loop forever on others, and silently drop faces that are not manifold, which would shift
 // triangle ids.  Here every polygon of the file is kept and fan-triangulated in file order (triangle
-// id = that order, DESIGN §9); anything malformed is an InputError naming the file and line.
+// id = that order, docs/design.md §9); anything malformed is an InputError naming the file and line.
 //
 // Normals: the file's where it has them (OBJ vn, OFF NOFF, PLY nx ny nz), made unit; elsewhere
 // area-weighted averages of the faces around each vertex.

@@ -1,4 +1,4 @@
-// Rigid animation, loading and posing (issue 8): glTF animation channels of translation, rotation and
+// Rigid animation, loading and posing: glTF animation channels of translation, rotation and
 // scale with each interpolation, posed at key times and between them as the glTF 2.0 specification
 // (Appendix C) says — compared with matrices computed by hand here, not with the code's own output —
 // hostile animation data refused with a one-line InputError, morph-target weights, several
@@ -52,7 +52,7 @@ std::function<std::string(Gltf&)> one_channel(std::vector<float> times, std::vec
 
 ls::Scene load(const std::string& json) { return ls::load_gltf_bytes(json, "anim.gltf", false); }
 
-// The posing test file (DESIGN §9 ids: instances are nodes 1, 2, 3):
+// The posing test file (docs/design.md §9 ids: instances are nodes 1, 2, 3):
 //   node 0 "rig": translation LINEAR (0,0,0) at 0 s -> (4,0,0) at 2 s; children 1, 2, 3
 //   node 1: rest translation (0,1,0); rotation LINEAR from identity at 0 s to the NEGATED quaternion of
 //           120 degrees about +z at 1 s (shortest path: the same rotation, reached the short way)

@@ -1,4 +1,4 @@
-// linespace-cpu end to end: the file formats, the JSON keys of DESIGN §9, and exit status 2 with a
+// linespace-cpu end to end: the file formats, the JSON keys of docs/design.md §9, and exit status 2 with a
 // one-line reason on bad input.
 #include "cpu/trace/embree_tracer.h"
 #include "tests/gltf_writer.h"

@@ -1,4 +1,4 @@
-// Embree 3 is the correctness peer (DESIGN §7): on the same rays, our exact structures (F-BVH and
+// Embree 3 is the correctness peer (docs/design.md §7): on the same rays, our exact structures (F-BVH and
 // 2L-BVH) and Embree (robust mode, world-space triangles) must find the same closest triangle, at the
 // same distance (t_close below), with the same barycentrics, and agree on occlusion.  Per scene and
 // structure, with >= 100,000 rays:
@@ -107,7 +107,7 @@ ClosestCounts compare_closest(const ls::SurfaceLookup& surfaces, const std::vect
     const lsk::Hit& a = ours[i];
     const lsk::Hit& b = embree[i];
     if (is_hit(a)) ++c.hits;
-    // The miss convention (DESIGN §9) holds on both sides.
+    // The miss convention (docs/design.md §9) holds on both sides.
     if (!is_hit(a) && !(a.t == kInf && a.instance == lsk::LS_INVALID)) ++c.bad_miss;
     if (!is_hit(b) && !(b.t == kInf && b.instance == lsk::LS_INVALID && b.u == 0.0f && b.v == 0.0f)) ++c.bad_miss;
     const bool same = is_hit(a) == is_hit(b) && a.instance == b.instance && a.triangle == b.triangle;

@@ -1,4 +1,4 @@
-// The Vulkan port against the CPU reference, bit for bit (DESIGN §5, issue 5): Line Space candidates of
+// The Vulkan port against the CPU reference, bit for bit (docs/design.md §5): Line Space candidates of
 // every shaft, traced hits (closest and any hit, all four structures), and renders.  These run on
 // whatever Vulkan device the machine has (lavapipe in CI); with no device at all they FAIL.
 #include "common/model/animation.h"

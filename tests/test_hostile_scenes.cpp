@@ -1,4 +1,4 @@
-// Hostile scenes (issue 7) not covered by test_scenes' bad-input cases: wrong component types, every
+// Hostile scenes not covered by test_scenes' bad-input cases: wrong component types, every
 // non-triangle mode, float overflow in vertices, transforms and emission, denormal and zero-area
 // geometry, 2^31 triangles, extreme cameras, zero- and huge-power lights.  Each is refused with an
 // InputError naming the file, or loads and renders finite pixels.  Through load_gltf_bytes: no files.

@@ -1,4 +1,4 @@
-// Structure names and per-bounce schedules (DESIGN §9): every accepted spelling, the canonical name
+// Structure names and per-bounce schedules (docs/design.md §9): every accepted spelling, the canonical name
 // round trip, the repeating last entry of a schedule, and the rejections (InputError).
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-// Top-level-only updates of two-level structures (issue 8, cpu/top_level_update.h): after posing a
+// Top-level-only updates of two-level structures (cpu/build/top_level_update.h): after posing a
 // scene and updating its 2L-BVH and 2L-LS (refusal angle 0), a moved instance is hit exactly where its
 // transformed geometry is — the same ids, the same bits of t and the same u and v (as numbers: the
 // sign of a zero may differ) as a flat BVH built from scratch on the posed scene and as brute force

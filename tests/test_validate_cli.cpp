@@ -1,5 +1,5 @@
 // linespace-validate end to end: bad input exits 2 with one line, and each study writes the files and
-// keys DESIGN §9 promises, with figures that must hold by construction.
+// keys docs/design.md §9 promises, with figures that must hold by construction.
 #include "tests/run_program.h"
 
 #include <catch2/catch.hpp>

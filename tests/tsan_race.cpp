@@ -1,5 +1,5 @@
 // Built in the TSan preset only (tests/CMakeLists.txt).  Checks the TSan setup itself: Debian's
-// uninstrumented TBB, the annotations of cpu/parallel.h and tests/tsan.supp together must still
+// uninstrumented TBB with the annotations of common/base/parallel.h must still
 // report a real race, and must not report what TBB orders.
 //
 //   tsan_race threads | parallel_for | parallel_reduce | parallel_invoke

@@ -1,5 +1,5 @@
-// CPU-versus-GPU cross-checks (issue 5): the Line Space candidates of every shaft of every LS node,
-// and traced hits (ids and the bits of t, u, v), must be identical on both back ends (DESIGN §5).
+// CPU-versus-GPU cross-checks: the Line Space candidates of every shaft of every LS node,
+// and traced hits (ids and the bits of t, u, v), must be identical on both back ends (docs/design.md §5).
 #pragma once
 
 #include "common/structure/accel.h"

@@ -9,7 +9,7 @@
 namespace ls {
 
 // Per pixel: the root mean square over RGB of the difference of the two images, each scaled by
-// `scale` and clamped to [0, 1] as in DESIGN §7 (so the map's mean square is the RMSE's square).
+// `scale` and clamped to [0, 1] as in docs/design.md §7 (so the map's mean square is the RMSE's square).
 std::vector<float> pixel_errors(const Image& reference, const Image& image, float scale);
 
 // Colours (inferno-like ramp, black = 0, pale yellow >= max_error), as linear values for write_png.

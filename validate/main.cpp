@@ -1,5 +1,5 @@
 // linespace-validate: measures what the Line Space's approximation costs in image error and buys in
-// speed and memory (DESIGN §7, §9).
+// speed and memory (docs/design.md §7, §9).
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
 #include "common/base/memory_budget.h"
 #include "common/base/ray_files.h"
@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
   ls_flags.add_to(bound_cmd, false);  // always the reference kernels: they count their work
   threads_flag.add_to(bound_cmd);
 
-  // CPU-versus-GPU cross-checks (issue 5): exit 1 on any difference.
+  // CPU-versus-GPU cross-checks: exit 1 on any difference.
   validate::CrossCheckCommand check;
   std::vector<float> check_offset;
   auto add_check_flags = [&](CLI::App* cmd) {

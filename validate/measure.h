@@ -1,5 +1,5 @@
 // One measurement of the validator: render a schedule with the same random numbers as the all-exact
-// reference and compare (DESIGN §6–7).  The RMSE of the total image is the figure the paper reports;
+// reference and compare (docs/design.md §6–7).  The RMSE of the total image is the figure the paper reports;
 // the RMSE of each bounce's own contribution shows where the error comes from.
 #pragma once
 
@@ -25,7 +25,7 @@ struct ImageSettings {
 
 struct Reference {
   RenderResult result;  // the all-exact (F-BVH) render
-  float scale = 1.0f;   // e of DESIGN §7, from its total image
+  float scale = 1.0f;   // e of docs/design.md §7, from its total image
   size_t bytes = 0;
 };
 

@@ -3,7 +3,7 @@
 //   bounce policy      exact F-BVH before bounce k, X from bounce k on (the paper's rule);
 //   throughput policy  exact F-BVH, except that a path whose throughput luminance is below T traces
 //                      that bounce's rays with X (render --throughput-switch T:X).
-// Every render uses the all-exact reference's random numbers, so RMSE (DESIGN §7, as `rmse`) measures
+// Every render uses the all-exact reference's random numbers, so RMSE (docs/design.md §7, as `rmse`) measures
 // the approximation alone.  Per configuration: RMSE, indirect MRays/s and the fraction of indirect
 // rays (bounces >= 1) traced with X.  Then, for each bounce-policy point, the throughput policy's RMSE
 // interpolated linearly between its two neighbouring points at the same fraction of rays on X, and at

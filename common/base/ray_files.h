@@ -1,4 +1,4 @@
-// The ray and hit files of DESIGN §9, little-endian:
+// The ray and hit files of docs/design.md §9, little-endian:
 //   ray: 8 x float32  ox oy oz tmin dx dy dz tmax                (32 bytes)
 //   hit: float32 t, uint32 instance, uint32 triangle, float32 u, float32 v   (20 bytes)
 // Both are the in-memory lsk::Ray / lsk::Hit records (this code runs on little-endian machines).

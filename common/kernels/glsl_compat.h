@@ -1,4 +1,4 @@
-// The prelude that lets one source be both GLSL 4.50 and C++20 (DESIGN §4, TOOLCHAIN.md).
+// The prelude that lets one source be both GLSL 4.50 and C++20 (docs/design.md §4, §11).
 //
 // Rules for every file in common/kernels/:
 //  - float literals carry the `f` suffix; unsigned literals the `u` suffix;
@@ -10,7 +10,7 @@
 //  - every function starts with LS_FN (C++ `inline`, so headers can be included by many files);
 //  - `#ifndef` guards, not `#pragma once`.
 // Functions that read the scene's buffers live in files meant to be included inside a C++ struct that
-// holds the buffers as pointers (see cpu/kernel_context.h), so `nodes[i]` reads the same in both.
+// holds the buffers as pointers (common/structure/trace_context.h, common/render/shade_context.h), so `nodes[i]` reads the same in both.
 #ifndef LS_GLSL_COMPAT_H
 #define LS_GLSL_COMPAT_H
 

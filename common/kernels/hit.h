@@ -34,7 +34,7 @@ LS_FN Hit empty_hit(IN(Ray) ray) {
   return hit;
 }
 
-// A miss reports t = +inf (DESIGN §9).
+// A miss reports t = +inf (docs/design.md §9).
 LS_FN Hit finish_hit(IN(Hit) hit) {
   Hit h = hit;
   if (h.triangle == LS_INVALID) h.t = ls_infinity();

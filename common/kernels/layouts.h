@@ -1,4 +1,4 @@
-// std430 structures shared by host and shaders, declared once (DESIGN §4).  Each has the same size
+// std430 structures shared by host and shaders, declared once (docs/design.md §4).  Each has the same size
 // and member offsets in C++ (glm::vec3 = 12 bytes, 4-aligned) and in GLSL std430 (vec3 16-aligned):
 // a vec3 is always followed by a 4-byte scalar so both layouts agree.  The static_asserts at the end
 // hold the C++ side to the std430 sizes and offsets, and tests/test_layouts.cpp compares every struct
@@ -12,7 +12,7 @@
 namespace lsk {
 #endif
 
-// A ray record, identical to the ray file (DESIGN §9): ox oy oz tmin dx dy dz tmax.
+// A ray record, identical to the ray file (docs/design.md §9): ox oy oz tmin dx dy dz tmax.
 struct Ray {
   vec3 origin;
   float tmin;
@@ -57,12 +57,12 @@ struct InstanceRecord {
   vec4 world_to_object1;
   vec4 world_to_object2;
   uint root;        // index of the object's root node in the nodes array
-  uint instance;    // instance id (DESIGN §9)
+  uint instance;    // instance id (docs/design.md §9)
   uint object;      // index of the unique mesh
   uint pad;
 };
 
-// A Line Space attached to one BVH node (DESIGN §3).  Its box is the node's box, widened where it is
+// A Line Space attached to one BVH node (docs/design.md §3).  Its box is the node's box, widened where it is
 // thin so that a flat node (one quad) still has shafts that cross it.  Candidates are stored per shaft
 // as an index local to the node's contiguous triangle range, in `bytes` bytes (1, 2 or 4, packed
 // little-endian into 32-bit words; all ones = empty shaft).  Each node has its own subdivision N, so

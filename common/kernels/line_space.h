@@ -1,4 +1,4 @@
-// Line Space geometry (DESIGN §3): patches, shafts, and the shaft a line falls in.
+// Line Space geometry (docs/design.md §3): patches, shafts, and the shaft a line falls in.
 //
 // Enumeration, fixed for every back end:
 //  - faces 0..5 are -X, +X, -Y, +Y, -Z, +Z: axis = face / 2, side = face % 2 (0 = lo, 1 = hi);

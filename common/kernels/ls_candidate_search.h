@@ -1,4 +1,4 @@
-// The Line Space candidate search (DESIGN §3), a *context* file included after traverse_bvh.h.
+// The Line Space candidate search (docs/design.md §3), a *context* file included after traverse_bvh.h.
 //
 // For a shaft of the LS node at BVH node `node`, ray 0 joins the centres of its start and end patches;
 // if it misses, rays 1..further_rays join the sub-patch points of ls_search_offsets(k), in that order.

@@ -1,4 +1,4 @@
-// The Line Space lookup during traversal (DESIGN §3), a *context* file like traverse_bvh.h: it reads
+// The Line Space lookup during traversal (docs/design.md §3), a *context* file like traverse_bvh.h: it reads
 //   ls_nodes[] LsNode, ls_candidates[] uint, tri_normals[] uvec4 (octahedral vertex normals),
 //   tris[], tri_ids[], tri_instances[], the parameters ls_cos2 (cos^2 of the refusal angle;
 //   negative: refuse everything, empty shafts included) and ls_reverse (non-zero: --ls-behind

@@ -1,4 +1,4 @@
-// Counter-based random numbers (DESIGN §6): no state, a pure function of (seed, pixel, sample,
+// Counter-based random numbers (docs/design.md §6): no state, a pure function of (seed, pixel, sample,
 // bounce, dimension), identical on CPU and GPU.  Every structure therefore sees the same paths, and
 // an RMSE between two renders measures the approximation alone, not noise.
 #ifndef LS_RNG_H

@@ -2,7 +2,7 @@
 // the power heuristic for multiple importance sampling.  Shared by CPU and GPU so both draw the same
 // paths from the same random numbers.  Every sum and product is `precise`: without it a GPU compiler
 // may reassociate (lavapipe does) or fuse.  No sin or cos (see cos_sin_turns): bit-identical on
-// lavapipe; on real GPUs sqrt and division may differ in the last bits (TOOLCHAIN.md).
+// lavapipe; on real GPUs sqrt and division may differ in the last bits (docs/design.md §11).
 #ifndef LS_SAMPLING_H
 #define LS_SAMPLING_H
 

@@ -1,4 +1,4 @@
-// The path tracer's per-path steps (cpu/path_tracer.h), once for CPU and GPU (DESIGN §4): start a
+// The path tracer's per-path steps (cpu/path_tracer.h), once for CPU and GPU (docs/design.md §4): start a
 // path at the camera, shade the hit of its segment (surface, MIS-weighted emission, a light sample for
 // next-event estimation with its shadow ray, the next direction) and add a shadow ray's light.
 //
@@ -11,7 +11,7 @@
 // Every sum and product is spelled out in the order GLM evaluates it (mat4 * vec4, mat3 * vec3, dot,
 // cross, length = sqrt(dot), normalize = v * (1 / sqrt(dot))), so the CPU keeps its earlier results bit
 // for bit and lavapipe, which rounds each operation like the CPU, gives the same.  sqrt, division, sin
-// and cos are not portable to real GPUs (TOOLCHAIN.md): there the paths agree, not their last bits.
+// and cos are not portable to real GPUs (docs/design.md §11): there the paths agree, not their last bits.
 #ifndef LS_SHADE_PATH_H
 #define LS_SHADE_PATH_H
 

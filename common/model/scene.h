@@ -1,7 +1,7 @@
 // The scene model every loader produces and every structure consumes (C++ only).
 //
 // A Mesh is an *object*: geometry in its own object space.  An Instance places one mesh in the world
-// with an affine transform.  Ids (DESIGN §9): instance id = index into Scene::instances (the loaders
+// with an affine transform.  Ids (docs/design.md §9): instance id = index into Scene::instances (the loaders
 // order instances by glTF node index); triangle id = index into Mesh::triangles.
 #pragma once
 

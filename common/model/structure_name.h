@@ -1,4 +1,4 @@
-// Names of the acceleration structures and per-bounce schedules (DESIGN §9):
+// Names of the acceleration structures and per-bounce schedules (docs/design.md §9):
 //   bvh (alias f-bvh), 2l-bvh, f-ls:D:N, 2l-ls:D:N   (f-ls(D,N) and 2l-ls(D,N) accepted too)
 //   2l-ls:auto: a two-level Line Space whose D and N are chosen per object under --ls-budget MB
 //   schedule: comma-separated structures, one per bounce from bounce 0, the last repeating.

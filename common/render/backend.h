@@ -22,7 +22,7 @@ class Backend {
   // Who traces: "" for this CPU (reports then say "cpu: MODEL"), else the device's description.
   virtual std::string device() const = 0;
   virtual Accel build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) = 0;
-  // `build`: builds and prints the structure (DESIGN §9 keys), with what this backend adds.
+  // `build`: builds and prints the structure (docs/design.md §9 keys), with what this backend adds.
   virtual void print_build(const Scene& scene, const StructureSpec& spec, const AccelOptions& options, bool json) = 0;
   // `trace`: hits and Line Space counters (added to *counters); `timing` says how long, for the log line.
   virtual std::vector<lsk::Hit> trace(const Accel& accel, const LsLookup& lookup, const std::vector<lsk::Ray>& rays,

@@ -1,4 +1,4 @@
-// Image error as DESIGN §7 defines it: both linear images are scaled by e = 1 / (99th-percentile
+// Image error as docs/design.md §7 defines it: both linear images are scaled by e = 1 / (99th-percentile
 // luminance of the reference), clamped to [0, 1], and the root of the mean squared difference over
 // all pixels and RGB channels is taken (comparable in scale to the paper's .002-.044).
 #pragma once

@@ -1,4 +1,4 @@
-// The partial a sharded render writes (`render --shard K/N` or `--tiles A:B`; README "Sharded
+// The partial a sharded render writes (`render --shard K/N` or `--tiles A:B`; docs/usage.md "Sharded
 // renders"): one lossless float EXR holding the bounce images and the total exactly as the single
 // render has them after averaging, zero outside the shard's tiles, with channels total.R/G/B and
 // bounce_K.R/G/B.  Its header carries everything `merge` needs, so the EXR alone suffices (the

@@ -1,4 +1,4 @@
-// Sharded rendering on the command line (README "Sharded renders"): `render --tiles A:B` or
+// Sharded rendering on the command line (docs/usage.md, "Sharded renders"): `render --tiles A:B` or
 // `--shard K/N` renders only those tiles and writes a partial (render_partial.h); `merge` combines
 // the partials into the single render's files (merge_partials.h).  Distributing the shards is left to
 // an existing scheduler (GNU parallel, a Slurm job array): there is no cluster code here.

@@ -1,4 +1,4 @@
-// Which pixels a sharded render computes (README "Sharded renders").  The image is cut into square
+// Which pixels a sharded render computes (docs/usage.md, "Sharded renders").  The image is cut into square
 // tiles of `tile_size` pixels, numbered row-major from the top-left corner; the tiles of the last
 // column and row are cut off by the image border.  A shard renders a set of whole tiles.
 //

@@ -12,7 +12,7 @@ namespace ls {
 // Rebuild: a fresh SAH build over the new boxes, exactly what build_accel() would make on the posed
 // scene (same nodes, same records, bit for bit).  Refit: the old tree and instance order with every
 // box recomputed bottom-up; cheaper, but its boxes loosen as instances drift from where the tree was
-// built.  Which is the default was measured (README, "Rigid animation").
+// built.  Which is the default was measured (docs/performance.md, "Rigid animation").
 enum class TopLevelMode { Rebuild, Refit };
 
 // "rebuild" or "refit"; throws InputError.

@@ -1,4 +1,4 @@
-// The command line both programs share (DESIGN §9): linespace-cpu and linespace-gpu declare their
+// The command line both programs share (docs/design.md §9): linespace-cpu and linespace-gpu declare their
 // subcommands and flags here, once, and differ only in their Backend, which says where structures are
 // built, rays traced and images rendered.  Exit status: 0 success, 1 a check failed, 2 bad input or
 // usage (a one-line reason on stderr), 128 + signal when interrupted.

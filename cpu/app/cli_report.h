@@ -1,4 +1,4 @@
-// What `build` and `trace` print, shared by linespace-cpu and linespace-gpu (DESIGN §9: the same keys
+// What `build` and `trace` print, shared by linespace-cpu and linespace-gpu (docs/design.md §9: the same keys
 // from both programs).  The flags they share are in cli_flags.h.
 #pragma once
 
@@ -11,7 +11,7 @@
 
 namespace ls {
 
-// Prints what `build` reports (DESIGN §9 keys); `device`, when given, names who built the candidates.
+// Prints what `build` reports (docs/design.md §9 keys); `device`, when given, names who built the candidates.
 void print_build(const Accel& a, bool json, const std::string& device = "");
 
 // A 2l-ls:auto plan (ls_budget.h): as JSON (the `ls_plan` key of build --json), and as a table.

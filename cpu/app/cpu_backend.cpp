@@ -76,7 +76,7 @@ class CpuBackend : public Backend {
     ls::print_build(build_planned_accel(scene, spec, options), json);
   }
   // With --traversal reference the log line adds the kernels' work counts (the 2l-ls:auto work model
-  // is fitted to them: README, "2l-ls:auto").
+  // is fitted to them: docs/performance.md, "Per-object Line Space under a memory budget").
   std::vector<lsk::Hit> trace(const Accel& accel, const LsLookup& lookup, const std::vector<lsk::Ray>& rays, bool any_hit,
                               lsk::LsCounters* counters, std::string* note) override {
     std::vector<lsk::Hit> hits(rays.size());

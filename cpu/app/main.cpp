@@ -1,4 +1,4 @@
-// linespace-cpu: the command line of the CPU reference (DESIGN §9; the subcommands and flags are
+// linespace-cpu: the command line of the CPU reference (docs/design.md §9; the subcommands and flags are
 // cli_program.h's, shared with linespace-gpu).  Structures are built and traced on all CPU threads (or --threads),
 // and bench runs Embree 3 beside them.
 #include "cpu/app/cli_program.h"

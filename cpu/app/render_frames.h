@@ -1,4 +1,4 @@
-// `render --frames A:B` (issue 8, rigid animation): renders frames A..B of a scene's animation, frame f
+// `render --frames A:B` (rigid animation): renders frames A..B of a scene's animation, frame f
 // posed at t = f / fps seconds, and measures what each frame's structures cost to bring up to date.
 //
 // Two-level structures (2l-bvh, 2l-ls:D:N) are built once, on frame A's pose, and then updated per

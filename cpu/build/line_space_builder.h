@@ -1,4 +1,4 @@
-// Builds the Line Space of an F-LS or 2L-LS structure (DESIGN §3, paper §3.1–3.2): an LsNode for every
+// Builds the Line Space of an F-LS or 2L-LS structure (docs/design.md §3, paper §3.1–3.2): an LsNode for every
 // BVH node at integration depth D (of the flat BVH, or of every unique object's BVH, stored once per
 // mesh however many instances use it), and one candidate per shaft found by the single-source search
 // kernel (common/kernels/ls_candidate_search.h), in parallel with TBB.

@@ -10,7 +10,7 @@
 //          more than 1e-3 of the scene's diagonal away; for shadow rays: occluded or not changed),
 //          over all pilot rays;
 //   work   box tests + 2.3 x triangle tests + 5.7 x Line Space lookups of those rays (the weights
-//          are the reference traversal's instruction costs, measured: README "2l-ls:auto"); the
+//          are the reference traversal's instruction costs, measured: docs/performance.md, "Per-object Line Space ..."); the
 //          option's saved work is the exact traversal's minus its own.
 //   bytes  its LS nodes and candidates, exactly as the builder lays them out.
 // Summed over objects, the plan minimises the error subject to

@@ -2,7 +2,7 @@
 // estimation and multiple importance sampling (power heuristic), a background radiance for rays that
 // leave the scene, and the acceleration structure chosen per bounce by a schedule.
 //
-// Bounces (DESIGN §3): bounce 0 is the camera ray and the shadow ray from its hit; bounce k >= 1 is
+// Bounces (docs/design.md §3): bounce 0 is the camera ray and the shadow ray from its hit; bounce k >= 1 is
 // the k-th indirect segment and the shadow ray from its hit.  The image of bounce k holds what the
 // rays of bounce k found: emission hit by its segment (MIS-weighted; weight 1 at bounce 0) plus the
 // light its shadow ray let through.  The total image is their sum.  At the last bounce the light

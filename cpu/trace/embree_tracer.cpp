@@ -1,4 +1,4 @@
-// Embree 3 as the correctness and performance peer (DESIGN §7).
+// Embree 3 as the correctness and performance peer (docs/design.md §7).
 //
 // The scene is handed to Embree as world-space triangles, one triangle geometry per instance, attached
 // under the instance id (geomID = instance id, primID = triangle id), so Embree's ids are ours.  The

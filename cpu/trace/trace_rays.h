@@ -29,7 +29,7 @@ struct TraceWorkTotals {
   uint64_t box_tests_in_ls = 0, triangle_tests_in_ls = 0;
 };
 // That work in box tests: a triangle test and a Line Space lookup weighed by instruction counts of the
-// reference traversal fitted over seven structures (README, "2l-ls:auto").
+// reference traversal fitted over seven structures (docs/performance.md, "Per-object Line Space under a memory budget").
 constexpr double kTriangleTestWork = 2.3;
 constexpr double kLookupWork = 5.7;
 inline double work_units(uint64_t box_tests, uint64_t triangle_tests, uint64_t lookups) {
