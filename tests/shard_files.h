@@ -4,7 +4,7 @@
 #pragma once
 
 #include "common/render/image_output.h"
-#include "tests/run_program.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -8,6 +8,7 @@
 #include "common/structure/accel.h"
 #include "cpu/build/build_accel.h"
 #include "cpu/build/bvh_builder.h"
+#include "tests/test_helpers.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -26,17 +27,9 @@
 using ls::Bounds;
 using ls::BvhBuildOptions;
 using ls::BvhBuildResult;
+using namespace test_support;  // Rng: floats from the top 24 bits of a draw
 
 namespace {
-
-// Deterministic uniform floats in [0, 1): the top 24 bits of a 32-bit draw.
-struct Rng {
-  std::mt19937 gen;
-  explicit Rng(uint32_t seed) : gen(seed) {}
-  float uniform() { return float(gen() >> 8) * 0x1.0p-24f; }
-  float range(float lo, float hi) { return lo + (hi - lo) * uniform(); }
-  glm::vec3 vec(float lo, float hi) { return glm::vec3(range(lo, hi), range(lo, hi), range(lo, hi)); }
-};
 
 Bounds box_of(const glm::vec3& lo, const glm::vec3& hi) {
   Bounds b;
@@ -447,43 +440,6 @@ TEST_CASE("build_bvh: zero boxes is an input error", "[bvh]") {
 
 namespace {
 
-ls::Mesh make_mesh(std::vector<glm::vec3> positions, std::vector<glm::uvec3> triangles, const std::string& name) {
-  ls::Mesh m;
-  m.name = name;
-  m.positions = std::move(positions);
-  m.triangles = std::move(triangles);
-  m.normals.assign(m.positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
-  m.materials.assign(m.triangles.size(), 0u);
-  return m;
-}
-
-ls::Mesh random_soup(size_t n, uint32_t seed, const std::string& name) {
-  Rng rng(seed);
-  std::vector<glm::vec3> p;
-  std::vector<glm::uvec3> t;
-  for (size_t i = 0; i < n; ++i) {
-    const glm::vec3 c = rng.vec(-1.0f, 1.0f);
-    for (int k = 0; k < 3; ++k) p.push_back(c + rng.vec(-0.1f, 0.1f));
-    t.push_back(glm::uvec3(3 * i, 3 * i + 1, 3 * i + 2));
-  }
-  return make_mesh(p, t, name);
-}
-
-// An indexed grid of 2 * cells^2 triangles sharing vertices.
-ls::Mesh grid(int cells, const std::string& name) {
-  std::vector<glm::vec3> p;
-  std::vector<glm::uvec3> t;
-  for (int j = 0; j <= cells; ++j)
-    for (int i = 0; i <= cells; ++i) p.push_back(glm::vec3(float(i) / float(cells), float(j) / float(cells), 0.0f));
-  const auto at = [&](int i, int j) { return uint32_t(j * (cells + 1) + i); };
-  for (int j = 0; j < cells; ++j)
-    for (int i = 0; i < cells; ++i) {
-      t.push_back(glm::uvec3(at(i, j), at(i + 1, j), at(i + 1, j + 1)));
-      t.push_back(glm::uvec3(at(i, j), at(i + 1, j + 1), at(i, j + 1)));
-    }
-  return make_mesh(p, t, name);
-}
-
 glm::mat4 transform(const glm::vec3& translate, float angle, const glm::vec3& axis, const glm::vec3& scale) {
   glm::mat4 m = glm::translate(glm::mat4(1.0f), translate);
   m = glm::rotate(m, angle, axis);
@@ -694,7 +650,7 @@ void check_two_level(const ls::Scene& scene, const ls::Accel& a, int max_leaf_si
 
 TEST_CASE("accel: one mesh used by 64 instances", "[accel]") {
   ls::Scene scene = base_scene();
-  scene.meshes.push_back(random_soup(500, 11, "soup"));
+  scene.meshes.push_back(random_soup(500, 11, 1.0f, 0.1f, "soup"));
   for (int i = 0; i < 64; ++i) {
     const glm::vec3 t(float(i % 8) * 3.0f, float(i / 8) * 3.0f, 0.0f);
     scene.instances.push_back(
@@ -727,11 +683,11 @@ TEST_CASE("accel: one mesh used by 64 instances", "[accel]") {
 
 TEST_CASE("accel: several meshes, some shared, one unused", "[accel]") {
   ls::Scene scene = base_scene();
-  scene.meshes.push_back(random_soup(300, 21, "a"));
-  scene.meshes.push_back(grid(10, "grid"));
-  scene.meshes.push_back(random_soup(50, 22, "unused"));
-  scene.meshes.push_back(random_soup(1, 23, "single"));
-  scene.meshes.push_back(grid(1, "quad"));
+  scene.meshes.push_back(random_soup(300, 21, 1.0f, 0.1f, "a"));
+  scene.meshes.push_back(square_grid(10, 0.0f, 1.0f, "grid"));
+  scene.meshes.push_back(random_soup(50, 22, 1.0f, 0.1f, "unused"));
+  scene.meshes.push_back(random_soup(1, 23, 1.0f, 0.1f, "single"));
+  scene.meshes.push_back(square_grid(1, 0.0f, 1.0f, "quad"));
   const std::vector<std::pair<uint32_t, glm::mat4>> placed = {
       {1, transform(glm::vec3(0.0f), 0.0f, glm::vec3(0, 0, 1), glm::vec3(1.0f))},
       {0, transform(glm::vec3(5, 0, 0), 0.7f, glm::vec3(1, 0, 0), glm::vec3(2.0f, 0.5f, 1.0f))},
@@ -780,8 +736,8 @@ TEST_CASE("accel: single triangle and single instance scenes", "[accel]") {
 
 TEST_CASE("accel: large flat scene", "[accel]") {
   ls::Scene scene = base_scene();
-  scene.meshes.push_back(random_soup(20000, 31, "big"));
-  scene.meshes.push_back(grid(60, "grid"));
+  scene.meshes.push_back(random_soup(20000, 31, 1.0f, 0.1f, "big"));
+  scene.meshes.push_back(square_grid(60, 0.0f, 1.0f, "grid"));
   scene.instances.push_back(instance(0, glm::mat4(1.0f)));
   scene.instances.push_back(instance(1, transform(glm::vec3(-0.5f, -0.5f, 0.0f), 0.0f, glm::vec3(0, 0, 1), glm::vec3(1.0f))));
   scene.instances.push_back(instance(0, transform(glm::vec3(0, 0, 3), 0.5f, glm::vec3(0, 1, 0), glm::vec3(0.5f))));

@@ -2,6 +2,7 @@
 // one-line reason on bad input.
 #include "cpu/trace/embree_tracer.h"
 #include "tests/gltf_writer.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -18,38 +19,16 @@
 #include <tuple>
 #include <utility>
 #include <vector>
-#include <sys/wait.h>
-#include <unistd.h>
 
+using namespace test_support;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out, err;
-};
-
 // Each test process gets its own folder: ctest runs test cases in parallel.
-fs::path temp(const std::string& name) {
-  return fs::temp_directory_path() / ("linespace_cli_test_" + std::to_string(getpid())) / name;
-}
+fs::path temp(const std::string& name) { return temp_path("cli_test", name); }
 
-Run run(const std::string& args) {
-  fs::create_directories(temp(""));
-  const std::string out = temp("stdout").string(), err = temp("stderr").string();
-  const std::string cmd = std::string(LINESPACE_CPU) + " " + args + " >" + out + " 2>" + err;
-  const int raw = std::system(cmd.c_str());
-  Run r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  auto slurp = [](const std::string& p) {
-    std::ifstream f(p);
-    return std::string(std::istreambuf_iterator<char>(f), {});
-  };
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+Run run(const std::string& args) { return run_program(LINESPACE_CPU, args, "cli_test"); }
 
 void write_text(const fs::path& p, const std::string& text) {
   std::ofstream f(p, std::ios::binary);
@@ -335,69 +314,21 @@ TEST_CASE("over-budget structures and renders exit 2 within seconds naming estim
   CHECK(!fs::exists(temp("big")));
 }
 
-namespace {
-
-// Whether process `pid` runs linespace-cpu (not the forked test still before exec, which carries
-// Catch's handlers) and has a handler for `signal` (the SigCgt mask of /proc/PID/status).
-bool catches(pid_t pid, int signal) {
-  std::error_code ec;
-  if (fs::read_symlink("/proc/" + std::to_string(pid) + "/exe", ec) != fs::canonical(LINESPACE_CPU, ec)) return false;
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (signal - 1)) & 1u;
-  return false;
-}
-
-// Starts linespace-cpu with `args` (stderr to err_path), sends `signal` once it has run `delay` seconds
-// with its handlers installed, and returns its exit status (-1: killed by a signal or still running
-// 60 s later).
-int run_and_signal(const std::vector<std::string>& args, const std::string& err_path, int signal, double delay) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> argv{const_cast<char*>(LINESPACE_CPU)};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    if (!std::freopen(err_path.c_str(), "w", stderr) || !std::freopen("/dev/null", "w", stdout)) _exit(99);
-    execv(LINESPACE_CPU, argv.data());
-    _exit(98);
-  }
-  // Wait until the program has installed its handler (SigCgt in /proc), however slowly it starts,
-  // then give it `delay` seconds of work before the signal.
-  for (int waited = 0; waited < 300 && !catches(pid, signal); ++waited) usleep(100000);
-  usleep(useconds_t(delay * 1e6));
-  kill(pid, signal);
-  int status = 0;
-  for (int waited = 0; waited < 600; ++waited) {  // up to 60 s
-    if (waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    usleep(100000);
-  }
-  kill(pid, SIGKILL);
-  waitpid(pid, &status, 0);
-  return -1;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
-}  // namespace
-
 TEST_CASE("SIGINT during render and SIGTERM during a build exit 128+signal leaving no output file", "[cli]") {
   fs::create_directories(temp(""));
   const fs::path out = temp("interrupted_render"), err = temp("interrupt.err");
   fs::remove_all(out);
   // Far longer than the delay: the signal arrives mid-render.
-  int status = run_and_signal({"render", "--scene", "builtin:cornell", "--size", "256x256", "--spp", "65536", "--out",
-                               out.string()},
+  int status = run_and_signal(LINESPACE_CPU,
+                              {"render", "--scene", "builtin:cornell", "--size", "256x256", "--spp", "65536", "--out", out.string()},
                               err.string(), SIGINT, 1.5);
   INFO("stderr: " << slurp(err));
   CHECK(status == 130);
   CHECK(slurp(err).find("interrupted by SIGINT") != std::string::npos);
   CHECK((!fs::exists(out) || fs::is_empty(out)));
 
-  status = run_and_signal({"build", "--scene", "builtin:instances", "--structure", "f-ls:6:14"}, err.string(), SIGTERM, 1.5);
+  status = run_and_signal(LINESPACE_CPU, {"build", "--scene", "builtin:instances", "--structure", "f-ls:6:14"}, err.string(),
+                          SIGTERM, 1.5);
   INFO("stderr: " << slurp(err));
   CHECK(status == 143);
   CHECK(slurp(err).find("interrupted by SIGTERM") != std::string::npos);
@@ -599,8 +530,9 @@ TEST_CASE("SIGINT during render --frames exits 130 leaving only whole frames and
   fs::create_directories(temp(""));
   const fs::path out = temp("interrupted_frames"), err = temp("frames_interrupt.err");
   fs::remove_all(out);
-  const int status = run_and_signal({"render", "--scene", "builtin:cornell", "--schedule", "2l-bvh", "--size", "64x64", "--spp", "512",
-                                     "--bounces", "1", "--frames", "0:1000", "--no-flat-comparison", "--out", out.string()},
+  const int status = run_and_signal(LINESPACE_CPU,
+                                    {"render", "--scene", "builtin:cornell", "--schedule", "2l-bvh", "--size", "64x64", "--spp",
+                                     "512", "--bounces", "1", "--frames", "0:1000", "--no-flat-comparison", "--out", out.string()},
                                     err.string(), SIGINT, 2.0);
   INFO("stderr: " << slurp(err));
   CHECK(status == 130);

@@ -15,6 +15,7 @@
 #include "cpu/trace/ray_generators.h"
 #include "cpu/trace/trace_rays.h"
 #include "scenes/load_scene.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <tiny_gltf.h>
@@ -31,6 +32,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+using namespace test_support;  // StdRng: the standard distributions
 
 namespace {
 
@@ -301,19 +304,6 @@ ls::Mesh bumpy_sphere(std::mt19937& rng, int rings, int segments) {
   return mesh;
 }
 
-ls::Mesh triangle_soup(std::mt19937& rng, int count) {
-  std::uniform_real_distribution<float> centre(-1.0f, 1.0f), offset(-0.25f, 0.25f);
-  ls::Mesh mesh;
-  mesh.name = "soup";
-  for (int i = 0; i < count; ++i) {
-    const glm::vec3 c(centre(rng), centre(rng), centre(rng));
-    const uint32_t base = uint32_t(mesh.positions.size());
-    for (int k = 0; k < 3; ++k) mesh.positions.push_back(c + glm::vec3(offset(rng), offset(rng), offset(rng)));
-    mesh.triangles.push_back(glm::uvec3(base, base + 1, base + 2));
-  }
-  return mesh;
-}
-
 ls::Mesh grid(int n) {
   ls::Mesh mesh;
   mesh.name = "grid";
@@ -329,26 +319,17 @@ ls::Mesh grid(int n) {
   return mesh;
 }
 
-void finish_mesh(ls::Mesh& mesh) {
-  // Normals: the loaders guarantee one per position; a radial one is enough for tests.
-  mesh.normals.clear();
-  for (const glm::vec3& p : mesh.positions) {
-    const float len = glm::length(p);
-    mesh.normals.push_back(len > 0.0f ? p / len : glm::vec3(0.0f, 1.0f, 0.0f));
-  }
-  mesh.materials.assign(mesh.triangles.size(), 0u);
-}
-
 ls::Scene random_instanced_scene(uint32_t seed, int instances) {
-  std::mt19937 rng(seed);
+  StdRng draws(seed);  // one generator for everything below, the soup's standard distributions included
+  std::mt19937& rng = draws.gen;
   ls::Scene scene;
   scene.name = "random-instanced";
   scene.materials.push_back(ls::Material{});
   scene.meshes.push_back(bumpy_sphere(rng, 48, 96));
-  scene.meshes.push_back(triangle_soup(rng, 3000));
+  scene.meshes.push_back(scattered_soup(draws, 3000, 1.0f, 0.25f, "soup"));
   scene.meshes.push_back(grid(32));
   scene.meshes.push_back(bumpy_sphere(rng, 12, 24));
-  for (ls::Mesh& m : scene.meshes) finish_mesh(m);
+  for (ls::Mesh& m : scene.meshes) finish_with_radial_normals(m);
 
   std::uniform_real_distribution<float> pos(-8.0f, 8.0f), scale(0.3f, 2.5f), angle(0.0f, 6.2831853f), unit(-1.0f, 1.0f);
   std::uniform_int_distribution<int> mesh_pick(0, int(scene.meshes.size()) - 1);
@@ -383,7 +364,7 @@ TEST_CASE("embree tracer: ids, distances, barycentrics and conventions on two qu
   mesh.positions = {glm::vec3(0.0f, 0.0f, 0.0f), glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f),
                     glm::vec3(1.0f, 1.0f, 0.0f)};
   mesh.triangles = {glm::uvec3(0, 1, 2), glm::uvec3(1, 3, 2)};
-  finish_mesh(mesh);
+  finish_with_radial_normals(mesh);
   scene.meshes.push_back(mesh);
   ls::Instance a;
   a.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -2.0f));
@@ -464,7 +445,7 @@ TEST_CASE("embree tracer: instances without triangles are skipped, ids kept", "[
   ls::Mesh tri;
   tri.positions = {glm::vec3(-1.0f, -1.0f, 0.0f), glm::vec3(1.0f, -1.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f)};
   tri.triangles = {glm::uvec3(0, 1, 2)};
-  finish_mesh(tri);
+  finish_with_radial_normals(tri);
   scene.meshes = {empty, tri};
   ls::Instance i0;
   i0.mesh = 0;

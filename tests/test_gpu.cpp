@@ -14,6 +14,7 @@
 #include "gpu/gpu_renderer.h"
 #include "scenes/load_scene.h"
 #include "validate/cross_check.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 
@@ -47,20 +48,7 @@ Scene plane_scene(int cells) {
   Scene s;
   s.name = "plane";
   s.materials.push_back(Material{});
-  Mesh m;
-  for (int y = 0; y <= cells; ++y)
-    for (int x = 0; x <= cells; ++x) {
-      m.positions.push_back(glm::vec3(-1.0f + 2.0f * float(x) / float(cells), -1.0f + 2.0f * float(y) / float(cells), 0.0f));
-      m.normals.push_back(glm::vec3(0, 0, 1));
-    }
-  for (int y = 0; y < cells; ++y)
-    for (int x = 0; x < cells; ++x) {
-      const uint32_t a = uint32_t(y * (cells + 1) + x), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
-      m.triangles.push_back(glm::uvec3(a, b, d));
-      m.triangles.push_back(glm::uvec3(a, d, c));
-    }
-  m.materials.assign(m.triangles.size(), 0);
-  s.meshes.push_back(m);
+  s.meshes.push_back(test_support::square_grid(cells));
   s.instances.push_back(Instance{0, glm::mat4(1.0f), "plane"});
   s.camera = framing_camera(s);
   validate_scene(s);

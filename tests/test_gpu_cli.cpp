@@ -2,6 +2,7 @@
 // included), and its hit files, build report and render equal linespace-cpu's.
 #include "common/render/image_output.h"
 #include "tests/shard_files.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -12,37 +13,17 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 
+using namespace test_support;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out, err;
-};
+fs::path temp(const std::string& name) { return temp_path("gpu_cli_test", name); }
 
-fs::path temp(const std::string& name) {
-  return fs::temp_directory_path() / ("linespace_gpu_cli_test_" + std::to_string(getpid())) / name;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
+// `env`: assignments put in front of the command, as "A=1 B=2".
 Run run(const std::string& program, const std::string& args, const std::string& env = "") {
-  fs::create_directories(temp(""));
-  const std::string out = temp("stdout").string(), err = temp("stderr").string();
-  const std::string cmd = env + " " + program + " " + args + " >" + out + " 2>" + err;
-  const int raw = std::system(cmd.c_str());
-  Run r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return run_program(program, args, "gpu_cli_test", env);
 }
 
 size_t line_count(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }

@@ -6,6 +6,7 @@
 #include "cpu/trace/ray_generators.h"
 #include "cpu/trace/trace_rays.h"
 #include "scenes/load_scene.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -17,57 +18,11 @@
 #include <set>
 
 using namespace ls;
+using namespace test_support;
 
 namespace {
 
 float uniform(std::mt19937& rng) { return float(rng() >> 8) * (1.0f / 16777216.0f); }
-
-Scene single_mesh_scene(Mesh mesh, const std::vector<glm::mat4>& transforms = {glm::mat4(1.0f)}) {
-  Scene s;
-  s.name = "test";
-  s.materials.push_back(Material{});
-  mesh.materials.assign(mesh.triangles.size(), 0);
-  if (mesh.normals.size() != mesh.positions.size()) mesh.normals.assign(mesh.positions.size(), glm::vec3(0, 0, 1));
-  s.meshes.push_back(mesh);
-  for (const glm::mat4& m : transforms) s.instances.push_back(Instance{0, m, ""});
-  validate_scene(s);
-  return s;
-}
-
-// Random small triangles clustered in the unit cube, normals from the faces.
-Mesh random_soup(int count, uint32_t seed, float size = 0.08f) {
-  std::mt19937 rng(seed);
-  Mesh m;
-  for (int i = 0; i < count; ++i) {
-    const glm::vec3 c(uniform(rng), uniform(rng), uniform(rng));
-    glm::vec3 p[3];
-    for (auto& q : p) q = c + size * glm::vec3(uniform(rng) - 0.5f, uniform(rng) - 0.5f, uniform(rng) - 0.5f);
-    const glm::vec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
-    for (auto& q : p) {
-      m.positions.push_back(q);
-      m.normals.push_back(n);
-    }
-    m.triangles.push_back(glm::uvec3(3 * i, 3 * i + 1, 3 * i + 2));
-  }
-  return m;
-}
-
-// A planar grid in z = 0 over [-1, 1]^2.
-Mesh plane_grid(int cells) {
-  Mesh m;
-  for (int y = 0; y <= cells; ++y)
-    for (int x = 0; x <= cells; ++x) {
-      m.positions.push_back(glm::vec3(-1.0f + 2.0f * float(x) / float(cells), -1.0f + 2.0f * float(y) / float(cells), 0.0f));
-      m.normals.push_back(glm::vec3(0, 0, 1));
-    }
-  for (int y = 0; y < cells; ++y)
-    for (int x = 0; x < cells; ++x) {
-      const uint32_t a = uint32_t(y * (cells + 1) + x), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
-      m.triangles.push_back(glm::uvec3(a, b, d));
-      m.triangles.push_back(glm::uvec3(a, d, c));
-    }
-  return m;
-}
 
 std::vector<lsk::Ray> random_rays(size_t count, uint32_t seed, glm::vec3 lo = glm::vec3(-0.5f), glm::vec3 hi = glm::vec3(1.5f)) {
   std::mt19937 rng(seed);
@@ -95,7 +50,7 @@ bool same_bits(const std::vector<lsk::Hit>& a, const std::vector<lsk::Hit>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(lsk::Hit)) == 0;
 }
 
-// Rays from inside the unit cube (where random_soup lies, so inside its LS boxes) with intervals
+// Rays from inside the unit cube (where unit_cube_soup lies, so inside its LS boxes) with intervals
 // [tmin, tmax] of random start and length.
 std::vector<lsk::Ray> interval_rays() {
   std::mt19937 rng(23);
@@ -221,7 +176,7 @@ TEST_CASE("edge and corner and face-grazing lines map consistently", "[line_spac
 TEST_CASE("every stored candidate equals a brute-force search over its subtree", "[line_space]") {
   for (bool two_level : {false, true})
     for (int n : {1, 2, 3}) {
-      const Scene scene = single_mesh_scene(random_soup(300, 7 + uint32_t(n)));
+      const Scene scene = single_mesh_scene(unit_cube_soup(300, 7 + uint32_t(n)));
       StructureSpec spec = parse_structure(std::string(two_level ? "2l-ls:" : "f-ls:") + "2:" + std::to_string(n));
       AccelOptions opt = paper();
       opt.ls.further_rays = 4;
@@ -267,7 +222,7 @@ TEST_CASE("every stored candidate equals a brute-force search over its subtree",
 }
 
 TEST_CASE("a refusal angle of 0 gives exactly the exact structure's hits", "[line_space]") {
-  const Scene scene = single_mesh_scene(random_soup(2000, 3), {glm::mat4(1.0f), glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 0.1f, 0.0f))});
+  const Scene scene = single_mesh_scene(unit_cube_soup(2000, 3), {glm::mat4(1.0f), glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 0.1f, 0.0f))});
   const std::vector<lsk::Ray> rays = random_rays(20000, 11);
   for (const char* pair : {"bvh f-ls:4:3", "bvh f-ls:0:6", "2l-bvh 2l-ls:2:4", "2l-bvh 2l-ls:0:1"}) {
     const std::string p(pair);
@@ -298,7 +253,7 @@ TEST_CASE("a refusal angle of 0 gives exactly the exact hits on the built-in cor
 }
 
 TEST_CASE("on one large planar mesh every accepted approximation lands on the plane", "[line_space]") {
-  const Scene scene = single_mesh_scene(plane_grid(64));
+  const Scene scene = single_mesh_scene(square_grid(64));
   std::mt19937 rng(5);
   std::vector<lsk::Ray> rays(20000);
   for (lsk::Ray& r : rays) {
@@ -348,7 +303,7 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
     }
   }
   // Depth past the leaves: no LS node at all, and the exact structure's answers.
-  const Scene soup = single_mesh_scene(random_soup(500, 9));
+  const Scene soup = single_mesh_scene(unit_cube_soup(500, 9));
   const Accel deep = build_accel(soup, parse_structure("f-ls:40:2"), paper());
   REQUIRE(deep.ls_info.ls_nodes == 0);
   const std::vector<lsk::Ray> rays = random_rays(5000, 4);
@@ -369,7 +324,7 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
 
 TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes included", "[line_space]") {
   // Origins inside the soup's LS boxes: a candidate behind the origin must be refused, never reported.
-  const Scene scene = single_mesh_scene(random_soup(3000, 17));
+  const Scene scene = single_mesh_scene(unit_cube_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
     const Accel a = build_accel(scene, parse_structure(name), paper());
@@ -385,7 +340,7 @@ TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes inc
 }
 
 TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, and nothing is refused as behind", "[line_space]") {
-  const Scene scene = single_mesh_scene(random_soup(3000, 17));
+  const Scene scene = single_mesh_scene(unit_cube_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
   const LsLookup reverse = angle(89.0f, true);
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
@@ -567,7 +522,7 @@ TEST_CASE("2L-LS stores one Line Space per unique mesh however many instances us
   for (int i = 0; i < 64; ++i)
     many.push_back(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(float(i % 8) * 1.5f, float(i / 8) * 1.5f, 0.0f)),
                                0.1f * float(i), glm::vec3(0, 1, 0)));
-  const Mesh mesh = random_soup(400, 21);
+  const Mesh mesh = unit_cube_soup(400, 21);
   const Scene one = single_mesh_scene(mesh), sixty_four = single_mesh_scene(mesh, many);
   const Accel a1 = build_accel(one, parse_structure("2l-ls:2:3"), paper()), a64 = build_accel(sixty_four, parse_structure("2l-ls:2:3"), paper());
   CHECK(a64.ls_info.ls_nodes == a1.ls_info.ls_nodes);
@@ -578,7 +533,7 @@ TEST_CASE("2L-LS stores one Line Space per unique mesh however many instances us
 }
 
 TEST_CASE("compact and paper candidates give identical hits and compact is smaller", "[line_space]") {
-  const Scene scene = single_mesh_scene(random_soup(3000, 13));
+  const Scene scene = single_mesh_scene(unit_cube_soup(3000, 13));
   AccelOptions paper_mode = paper();
   paper_mode.ls.paper_candidates = true;
   for (const char* name : {"f-ls:3:4", "2l-ls:1:3"}) {
@@ -592,7 +547,7 @@ TEST_CASE("compact and paper candidates give identical hits and compact is small
 }
 
 TEST_CASE("an over-budget Line Space is refused before it is built", "[line_space]") {
-  const Scene scene = single_mesh_scene(random_soup(5000, 2));
+  const Scene scene = single_mesh_scene(unit_cube_soup(5000, 2));
   AccelOptions tight = paper();
   tight.limits.max_memory = 1 << 20;
   const auto start = std::chrono::steady_clock::now();

@@ -16,6 +16,7 @@
 #include "cpu/trace/fast_tracer.h"
 #include "cpu/trace/trace_rays.h"
 #include "scenes/load_scene.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 
@@ -24,50 +25,18 @@
 #include <random>
 #include <sstream>
 
+using namespace test_support;  // StdRng: the standard distributions
+
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr uint32_t kNone = lsk::LS_INVALID;
-
-struct Rng {
-  std::mt19937 gen;
-  explicit Rng(uint32_t seed) : gen(seed) {}
-  int integer(int a, int b) { return std::uniform_int_distribution<int>(a, b)(gen); }
-  float range(float a, float b) { return std::uniform_real_distribution<float>(a, b)(gen); }
-  // A point of the 1/step grid in [-extent, extent]^3.
-  glm::vec3 grid(float extent, int step) {
-    const int n = int(extent * float(step));
-    return glm::vec3(float(integer(-n, n)), float(integer(-n, n)), float(integer(-n, n))) / float(step);
-  }
-};
 
 std::string describe(const lsk::Hit& h) {
   std::ostringstream s;
   s.precision(9);
   s << "t=" << h.t << " inst=" << h.instance << " tri=" << h.triangle << " u=" << h.u << " v=" << h.v;
   return s.str();
-}
-
-ls::Mesh make_mesh(const std::vector<glm::vec3>& p, const std::vector<glm::uvec3>& t) {
-  ls::Mesh m;
-  m.positions = p;
-  m.normals.assign(p.size(), glm::vec3(0, 0, 1));
-  m.triangles = t;
-  m.materials.assign(t.size(), 0);
-  return m;
-}
-
-// Triangles with vertices on the 1/16 grid of [-1, 1]^3: exact, and so are their images below.
-ls::Mesh grid_soup(int n, uint32_t seed) {
-  Rng rng(seed);
-  std::vector<glm::vec3> p;
-  std::vector<glm::uvec3> t;
-  for (int i = 0; i < n; ++i) {
-    const glm::vec3 c = rng.grid(0.8f, 16);
-    for (int k = 0; k < 3; ++k) p.push_back(c + rng.grid(0.2f, 16));
-    t.emplace_back(3 * i, 3 * i + 1, 3 * i + 2);
-  }
-  return make_mesh(p, t);
 }
 
 ls::Mesh grid_box() {  // the closed cube [-0.5, 0.5]^3
@@ -98,11 +67,11 @@ ls::Scene animated_scene(bool exact) {
   s.name = exact ? "exact animation" : "general animation";
   s.materials.push_back(ls::Material{});
   s.meshes.push_back(make_mesh({{-8, -4, -8}, {8, -4, -8}, {8, -4, 8}, {-8, -4, 8}}, {{0, 1, 2}, {0, 2, 3}}));
-  s.meshes.push_back(grid_soup(400, 7));
+  s.meshes.push_back(lattice_soup(400, 7));
   s.meshes.push_back(grid_box());
   ls::Animation a;
   a.name = "test";
-  Rng rng(11);
+  StdRng rng(11);
   for (uint32_t i = 0; i < 10; ++i) {
     ls::Instance inst;
     inst.mesh = i == 0 ? 0u : i <= 6 ? 1u : 2u;
@@ -137,7 +106,7 @@ ls::Scene animated_scene(bool exact) {
 // Rays from grid points (so that carrying them into object space is exact) aimed into the boxes of the
 // moving instances, and some in random directions.
 std::vector<lsk::Ray> aimed_rays(const ls::Scene& s, size_t n, uint32_t seed) {
-  Rng rng(seed);
+  StdRng rng(seed);
   std::vector<lsk::Ray> rays;
   for (size_t r = 0; r < n; ++r) {
     lsk::Ray ray;

@@ -25,6 +25,7 @@
 #include "common/structure/accel.h"
 #include "cpu/build/build_accel.h"
 #include "cpu/trace/trace_rays.h"
+#include "tests/test_helpers.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -41,29 +42,14 @@
 #include <utility>
 #include <vector>
 
+using namespace test_support;  // Rng: floats from the top 24 bits of a draw
+
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr uint32_t kNone = lsk::LS_INVALID;
 constexpr double kRelT = 1e-5;     // t tolerance between structures that round differently
 constexpr double kEdgeBary = 1e-4;  // a hit this close (in barycentrics) to an edge may flip between structures
-
-// ---------------------------------------------------------------------------------------------------
-// Deterministic random numbers.
-
-struct Rng {
-  std::mt19937 gen;
-  explicit Rng(uint32_t seed) : gen(seed) {}
-  float uniform() { return float(gen() >> 8) * 0x1.0p-24f; }  // [0, 1)
-  float range(float lo, float hi) { return lo + (hi - lo) * uniform(); }
-  glm::vec3 vec(float lo, float hi) { return glm::vec3(range(lo, hi), range(lo, hi), range(lo, hi)); }
-  glm::vec3 unit() {  // uniform on the sphere
-    const float z = 1.0f - 2.0f * uniform();
-    const float phi = 6.28318530718f * uniform();
-    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-    return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
-  }
-};
 
 // ---------------------------------------------------------------------------------------------------
 // Reporting.
@@ -98,38 +84,8 @@ bool is_hit(const lsk::Hit& h) { return h.triangle != kNone; }
 bool same_ids(const lsk::Hit& a, const lsk::Hit& b) { return a.instance == b.instance && a.triangle == b.triangle; }
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, 4) == 0; }
 
-lsk::Ray make_ray(const glm::vec3& o, const glm::vec3& d, float tmin = 0.0f, float tmax = kInf) {
-  lsk::Ray r;
-  r.origin = o;
-  r.dir = d;
-  r.tmin = tmin;
-  r.tmax = tmax;
-  return r;
-}
-
 // ---------------------------------------------------------------------------------------------------
 // Scenes.
-
-ls::Mesh make_mesh(std::vector<glm::vec3> positions, std::vector<glm::uvec3> triangles) {
-  ls::Mesh m;
-  m.positions = std::move(positions);
-  m.triangles = std::move(triangles);
-  m.normals.assign(m.positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
-  m.materials.assign(m.triangles.size(), 0u);
-  return m;
-}
-
-ls::Mesh soup(size_t n, uint32_t seed, float extent = 1.0f, float size = 0.15f) {
-  Rng rng(seed);
-  std::vector<glm::vec3> p;
-  std::vector<glm::uvec3> t;
-  for (size_t i = 0; i < n; ++i) {
-    const glm::vec3 c = rng.vec(-extent, extent);
-    for (int k = 0; k < 3; ++k) p.push_back(c + rng.vec(-size, size));
-    t.push_back(glm::uvec3(3 * i, 3 * i + 1, 3 * i + 2));
-  }
-  return make_mesh(p, t);
-}
 
 // A closed, consistently oriented sphere: the icosahedron subdivided `levels` times, on the unit sphere.
 ls::Mesh icosphere(int levels) {
@@ -177,22 +133,6 @@ ls::Mesh cube() {
   return make_mesh(p, t);
 }
 
-// The square [-1, 1]^2 in the z = 0 plane as a grid of cells x cells quads, two triangles each.
-ls::Mesh grid(int cells) {
-  std::vector<glm::vec3> p;
-  for (int j = 0; j <= cells; ++j)
-    for (int i = 0; i <= cells; ++i)
-      p.push_back(glm::vec3(-1.0f + 2.0f * float(i) / float(cells), -1.0f + 2.0f * float(j) / float(cells), 0.0f));
-  const auto at = [&](int i, int j) { return uint32_t(j * (cells + 1) + i); };
-  std::vector<glm::uvec3> t;
-  for (int j = 0; j < cells; ++j)
-    for (int i = 0; i < cells; ++i) {
-      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return make_mesh(p, t);
-}
-
 glm::mat4 transform(const glm::vec3& translate, float angle, const glm::vec3& axis, const glm::vec3& scale) {
   glm::mat4 m = glm::translate(glm::mat4(1.0f), translate);
   m = glm::rotate(m, angle, axis);
@@ -214,18 +154,12 @@ ls::Scene scene_of(std::vector<ls::Mesh> meshes, const std::vector<std::pair<uin
   return s;
 }
 
-ls::Scene single_mesh_scene(ls::Mesh mesh, const glm::mat4& m = glm::mat4(1.0f)) {
-  std::vector<ls::Mesh> meshes;
-  meshes.push_back(std::move(mesh));
-  return scene_of(std::move(meshes), {{0u, m}});
-}
-
 // Soup, sphere and grid placed several times with rotations, non-uniform and mirroring scales.
 ls::Scene instanced_scene(uint32_t seed) {
   std::vector<ls::Mesh> meshes;
-  meshes.push_back(soup(300, seed, 1.0f, 0.2f));
+  meshes.push_back(random_soup(300, seed, 1.0f, 0.2f));
   meshes.push_back(icosphere(2));
-  meshes.push_back(grid(8));
+  meshes.push_back(square_grid(8));
   meshes.push_back(cube());
   Rng rng(seed + 1);
   std::vector<std::pair<uint32_t, glm::mat4>> placed;
@@ -536,7 +470,7 @@ void check_against_brute(const ls::Scene& scene, const std::vector<lsk::Ray>& ra
 // ===================================================================================================
 
 TEST_CASE("traversal: random soup against brute force", "[traversal]") {
-  const ls::Scene scene = single_mesh_scene(soup(2000, 101));
+  const ls::Scene scene = single_mesh_scene(random_soup(2000, 101));
   Rng rng(102);
   const std::vector<lsk::Ray> rays = random_rays(rng, 8000, 2.5f, 1.0f);
   check_against_brute(scene, rays, "soup");
@@ -580,7 +514,7 @@ TEST_CASE("traversal: N = 1 triangle scenes", "[traversal]") {
     aimed.push_back(make_ray(o, target - o));
   }
   for (const glm::mat4& m : {glm::mat4(1.0f), transform(glm::vec3(1, 2, 3), 1.0f, glm::vec3(0, 1, 0), glm::vec3(2.0f, -1.0f, 0.5f))}) {
-    const ls::Scene scene = single_mesh_scene(one, m);
+    const ls::Scene scene = single_mesh_scene(one, {m});
     check_against_brute(scene, rays, "one triangle");
     const Built b = build_both(scene);
     std::vector<lsk::Ray> world_aimed = aimed;
@@ -624,7 +558,7 @@ TEST_CASE("traversal: watertight closed meshes", "[traversal][watertight]") {
   std::vector<Case> cases;
   cases.push_back({"icosphere", icosphere(2), true});
   cases.push_back({"cube", cube(), true});
-  cases.push_back({"grid", grid(12), false});
+  cases.push_back({"grid", square_grid(12), false});
   enum Kind { kVertex, kMidpoint, kAlongEdge, kInside, kAxisParallel, kKinds };
   const char* kind_names[kKinds] = {"vertex", "edge midpoint", "point along an edge", "interior point", "axis-parallel onto grid"};
 
@@ -635,7 +569,7 @@ TEST_CASE("traversal: watertight closed meshes", "[traversal][watertight]") {
                                          : transform(glm::vec3(0.3f, -0.2f, 0.1f), 0.8f, glm::vec3(1, 2, 3), glm::vec3(1.3f, 0.7f, -1.1f));
       const std::string where = std::string(c.name) + (placement == 0 ? " (identity)" : " (rotated, scaled, mirrored)");
       INFO(where);
-      const ls::Scene scene = single_mesh_scene(c.mesh, m);
+      const ls::Scene scene = single_mesh_scene(c.mesh, {m});
       const WorldTris w = world_tris(scene);
       const Built b = build_both(scene);
       const ls::Mesh& mesh = c.mesh;
@@ -741,8 +675,9 @@ TEST_CASE("traversal: watertight closed meshes", "[traversal][watertight]") {
         for (size_t i = 0; i < rays.size(); ++i) {
           ++total[kinds[i]];
           const lsk::Hit& h = (*hits)[i];
+          // std::string("\n") first: GCC 12's -Wrestrict misfires on "\n" + std::string here.
           if ((!is_hit(h) || !(h.t <= limit)) && ++slipped[kinds[i]] <= 2)
-            examples[kinds[i]] += "\n" + describe(rays[i]) + " -> " + describe(h);
+            examples[kinds[i]] += std::string("\n") + describe(rays[i]) + " -> " + describe(h);
         }
         for (int k = 0; k < kKinds; ++k) {
           if (total[k] == 0) continue;
@@ -771,8 +706,8 @@ TEST_CASE("traversal: axis-parallel rays, box faces, edges and corners", "[trave
   // at x = 3 for inner nodes.
   std::vector<ls::Mesh> meshes;
   meshes.push_back(cube());
-  meshes.push_back(grid(4));
-  meshes.push_back(soup(400, 501, 1.0f, 0.2f));
+  meshes.push_back(square_grid(4));
+  meshes.push_back(random_soup(400, 501, 1.0f, 0.2f));
   const ls::Scene scene = scene_of(std::move(meshes), {{0u, glm::mat4(1.0f)},
                                                       {1u, transform(glm::vec3(0, 0, 5), 0.0f, glm::vec3(0, 0, 1), glm::vec3(1.0f))},
                                                       {2u, transform(glm::vec3(3, 0, 0), 0.0f, glm::vec3(0, 0, 1), glm::vec3(1.0f))}});
@@ -952,7 +887,7 @@ TEST_CASE("traversal: degenerate triangles are never hit", "[traversal]") {
                               {-1, 0, 0}, {1, 0, 0}, {3, 0, 0}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
   std::vector<glm::uvec3> t = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}, {9, 10, 11}, {0, 0, 1}, {7, 6, 8}, {5, 5, 3}};
   const size_t degenerate = t.size();
-  ls::Mesh normal = soup(50, 701, 1.5f, 0.3f);
+  ls::Mesh normal = random_soup(50, 701, 1.5f, 0.3f);
   for (const glm::uvec3& tri : normal.triangles) t.push_back(tri + glm::uvec3(uint32_t(p.size())));
   p.insert(p.end(), normal.positions.begin(), normal.positions.end());
   const ls::Mesh mesh = make_mesh(p, t);
@@ -969,7 +904,7 @@ TEST_CASE("traversal: degenerate triangles are never hit", "[traversal]") {
       if (i % 10 == 0) rays.push_back(make_ray(a - 2.0f * (c - a), c - a));  // along the line
     }
   for (const glm::mat4& m : {glm::mat4(1.0f), transform(glm::vec3(0.5f, 0, 0), 0.5f, glm::vec3(1, 1, 0), glm::vec3(1, 2, 1))}) {
-    const ls::Scene scene = single_mesh_scene(mesh, m);
+    const ls::Scene scene = single_mesh_scene(mesh, {m});
     const WorldTris w = world_tris(scene);
     const Built b = build_both(scene);
     // Zero-area in the space the structure tests in: world space for the brute force and F-BVH (a
@@ -1133,9 +1068,9 @@ std::vector<lsk::Ray> transformed_rays(const std::vector<lsk::Ray>& rays, float 
 TEST_CASE("traversal: numerical extremes: scales 1e-20, 1e20, 2^-60, 2^60 and a translation by 1e6", "[traversal][extremes]") {
   // A unit-scale scene: a soup at identity plus instanced meshes.
   std::vector<ls::Mesh> meshes;
-  meshes.push_back(soup(1500, 901, 1.0f, 0.15f));
+  meshes.push_back(random_soup(1500, 901, 1.0f, 0.15f));
   meshes.push_back(icosphere(2));
-  meshes.push_back(grid(6));
+  meshes.push_back(square_grid(6));
   const ls::Scene unit = scene_of(std::move(meshes),
                                   {{0u, glm::mat4(1.0f)},
                                    {1u, transform(glm::vec3(1.5f, 0, 0), 0.4f, glm::vec3(0, 1, 0), glm::vec3(0.5f, 0.3f, 0.4f))},
@@ -1315,9 +1250,9 @@ glm::vec3 tangent(const glm::vec3& n, Rng& rng) {
 
 TEST_CASE("traversal: offset rays never re-hit their own triangle", "[traversal][offset]") {
   std::vector<ls::Mesh> meshes;
-  meshes.push_back(soup(800, 1001, 1.0f, 0.2f));
+  meshes.push_back(random_soup(800, 1001, 1.0f, 0.2f));
   meshes.push_back(icosphere(2));
-  meshes.push_back(grid(8));
+  meshes.push_back(square_grid(8));
   meshes.push_back(cube());
   const ls::Scene unit = scene_of(std::move(meshes),
                                   {{0u, glm::mat4(1.0f)},

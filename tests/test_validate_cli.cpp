@@ -1,6 +1,6 @@
 // linespace-validate end to end: bad input exits 2 with one line, and each study writes the files and
 // keys docs/design.md §9 promises, with figures that must hold by construction.
-#include "tests/run_program.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

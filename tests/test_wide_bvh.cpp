@@ -11,6 +11,7 @@
 #include "cpu/trace/trace_rays.h"
 #include "cpu/trace/triangle_blocks.h"
 #include "scenes/load_scene.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>
@@ -28,16 +29,13 @@
 #include <random>
 #include <sstream>
 
+// StdRng: the standard distributions.  Meshes carry face normals as vertex normals (the Line Space
+// extrapolates them).
+using namespace test_support;
+
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-struct Rng {
-  std::mt19937 gen;
-  explicit Rng(uint32_t seed) : gen(seed) {}
-  float range(float a, float b) { return std::uniform_real_distribution<float>(a, b)(gen); }
-  glm::vec3 vec(float a, float b) { return glm::vec3(range(a, b), range(a, b), range(a, b)); }
-};
 
 std::string describe(const lsk::Hit& h) {
   std::ostringstream s;
@@ -113,54 +111,14 @@ void check_scene(const ls::Scene& scene, const std::string& name, const std::vec
     }
 }
 
-ls::Mesh make_mesh(std::vector<glm::vec3> positions, std::vector<glm::uvec3> triangles) {
-  ls::Mesh m;
-  m.positions = std::move(positions);
-  m.triangles = std::move(triangles);
-  m.normals.assign(m.positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
-  for (size_t t = 0; t < m.triangles.size(); ++t) {  // face normals as vertex normals (the LS extrapolates them)
-    const glm::uvec3 i = m.triangles[t];
-    const glm::vec3 n = glm::cross(m.positions[i.y] - m.positions[i.x], m.positions[i.z] - m.positions[i.x]);
-    if (glm::length(n) > 0.0f) m.normals[i.x] = m.normals[i.y] = m.normals[i.z] = glm::normalize(n);
-  }
-  m.materials.assign(m.triangles.size(), 0u);
-  return m;
-}
-
-ls::Mesh soup(size_t n, Rng& rng, float extent, float size) {
-  std::vector<glm::vec3> p;
-  std::vector<glm::uvec3> t;
-  for (size_t i = 0; i < n; ++i) {
-    const glm::vec3 c = rng.vec(-extent, extent);
-    for (int k = 0; k < 3; ++k) p.push_back(c + rng.vec(-size, size));
-    t.push_back(glm::uvec3(3 * i, 3 * i + 1, 3 * i + 2));
-  }
-  return make_mesh(p, t);
-}
-
-// Axis-aligned unit grid in z = 0: shared edges and vertices, and boxes flat in z.
-ls::Mesh grid(int cells) {
-  std::vector<glm::vec3> p;
-  for (int j = 0; j <= cells; ++j)
-    for (int i = 0; i <= cells; ++i) p.push_back(glm::vec3(float(i) / float(cells), float(j) / float(cells), 0.0f));
-  const auto at = [&](int i, int j) { return uint32_t(j * (cells + 1) + i); };
-  std::vector<glm::uvec3> t;
-  for (int j = 0; j < cells; ++j)
-    for (int i = 0; i < cells; ++i) {
-      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return make_mesh(p, t);
-}
-
 ls::Scene random_scene(uint32_t seed) {
-  Rng rng(seed);
+  StdRng rng(seed);
   ls::Scene s;
   s.name = "random";
   s.materials.push_back(ls::Material{});
-  s.meshes.push_back(soup(2000, rng, 1.0f, 0.15f));
-  s.meshes.push_back(grid(16));
-  s.meshes.push_back(soup(40, rng, 0.5f, 0.3f));
+  s.meshes.push_back(with_face_normals(scattered_soup(rng, 2000, 1.0f, 0.15f)));
+  s.meshes.push_back(with_face_normals(square_grid(16, 0.0f, 1.0f)));
+  s.meshes.push_back(with_face_normals(scattered_soup(rng, 40, 0.5f, 0.3f)));
   for (uint32_t i = 0; i < 12; ++i) {
     ls::Instance inst;
     inst.mesh = i % 3;
@@ -175,15 +133,6 @@ ls::Scene random_scene(uint32_t seed) {
   s.camera.target = glm::vec3(0.0f);
   ls::validate_scene(s);
   return s;
-}
-
-lsk::Ray ray(const glm::vec3& o, const glm::vec3& d, float tmin = 0.0f, float tmax = kInf) {
-  lsk::Ray r;
-  r.origin = o;
-  r.tmin = tmin;
-  r.dir = d;
-  r.tmax = tmax;
-  return r;
 }
 
 }  // namespace
@@ -245,7 +194,7 @@ TEST_CASE("wide BVH: same answers and counters with --ls-behind reverse", "[wide
 
 TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degenerate rays", "[wide]") {
   const ls::Scene scene = random_scene(4);
-  Rng rng(99);
+  StdRng rng(99);
   std::vector<lsk::Ray> rays;
   const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   for (int i = 0; i < 3000; ++i) {
@@ -255,15 +204,15 @@ TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degen
       case 0: d = axes[i / 6 % 6]; break;                                     // parallel to two slabs
       case 1: d[i / 6 % 3] = 0.0f; break;                                     // parallel to one slab
       case 2: d[i / 6 % 3] = 1e-30f; break;                                   // denormal-sized reciprocal
-      case 3: rays.push_back(ray(o, d, 0.5f, 3.0f)); continue;                // an interval
-      case 4: rays.push_back(ray(glm::vec3(o.x, o.y, 0.0f), d)); continue;    // origins in grid planes
+      case 3: rays.push_back(make_ray(o, d, 0.5f, 3.0f)); continue;           // an interval
+      case 4: rays.push_back(make_ray(glm::vec3(o.x, o.y, 0.0f), d)); continue;  // origins in grid planes
       default: break;
     }
-    rays.push_back(ray(o, d));
+    rays.push_back(make_ray(o, d));
   }
-  rays.push_back(ray(glm::vec3(0.0f), glm::vec3(0.0f)));                     // zero direction
-  rays.push_back(ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.0f, 0.0f), 2.0f, 1.0f));  // empty interval
-  rays.push_back(ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.2f, 0.1f), 0.0f, std::numeric_limits<float>::quiet_NaN()));
+  rays.push_back(make_ray(glm::vec3(0.0f), glm::vec3(0.0f)));                     // zero direction
+  rays.push_back(make_ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.0f, 0.0f), 2.0f, 1.0f));  // empty interval
+  rays.push_back(make_ray(glm::vec3(0.0f), glm::vec3(1.0f, 0.2f, 0.1f), 0.0f, std::numeric_limits<float>::quiet_NaN()));
   for (const auto& [width, exact_width] : {std::pair{4, 4}, {8, 8}, {4, 8}, {8, 4}})
     for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
       const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width, 0u, exact_width));
@@ -318,17 +267,17 @@ TEST_CASE("wide BVH: rays with infinite or NaN components take the ordered walk 
   const ls::Scene scene = random_scene(6);
   const float inf = kInf, nan = std::numeric_limits<float>::quiet_NaN();
   std::vector<lsk::Ray> rays;
-  Rng rng(17);
+  StdRng rng(17);
   for (int i = 0; i < 600; ++i) {
     glm::vec3 o = rng.vec(-4.0f, 4.0f), d = rng.vec(-1.0f, 1.0f);
     const float bad = i % 2 ? inf : nan;
     switch (i % 4) {
       case 0: o[i / 4 % 3] = i % 8 < 4 ? bad : -bad; break;
       case 1: d[i / 4 % 3] = i % 8 < 4 ? bad : -bad; break;
-      case 2: rays.push_back(ray(o, d, nan)); continue;
-      default: rays.push_back(ray(o, d, -inf, inf)); continue;
+      case 2: rays.push_back(make_ray(o, d, nan)); continue;
+      default: rays.push_back(make_ray(o, d, -inf, inf)); continue;
     }
-    rays.push_back(ray(o, d));
+    rays.push_back(make_ray(o, d));
   }
   for (const char* s : {"bvh", "2l-bvh", "f-ls:4:3", "2l-ls:2:3"}) {
     const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(4));
@@ -353,7 +302,7 @@ TEST_CASE("scale_pow2: the exponent-field shortcut gives the exact product, satu
     if (ex + e < -126) return 0.0f * x;
     return float(std::ldexp(double(x), e));  // exact in double, representable in float
   };
-  Rng rng(3);
+  StdRng rng(3);
   size_t checked = 0, mismatches = 0;
   for (uint32_t field = 0; field < 256; ++field)
     for (uint32_t k = 0; k < 6; ++k) {
@@ -374,7 +323,7 @@ TEST_CASE("scale_pow2: the exponent-field shortcut gives the exact product, satu
 }
 
 TEST_CASE("four-lane scale_pow2 of the triangle blocks equals the kernel's", "[wide]") {
-  Rng rng(5);
+  StdRng rng(5);
   size_t mismatches = 0;
   for (int e = -126; e <= 126; ++e) {
     const ls::Int4 one_minus_e(1 - e);
@@ -398,7 +347,7 @@ TEST_CASE("four-lane scale_pow2 of the triangle blocks equals the kernel's", "[w
 }
 
 // A float of random sign and mantissa with the exponent field `field` (0: denormal or zero).
-float float_with_field(Rng& rng, uint32_t field) {
+float float_with_field(StdRng& rng, uint32_t field) {
   const uint32_t mantissa = field == 0 && rng.gen() % 4 == 0 ? 0u : uint32_t(rng.gen()) & 0x7FFFFFu;
   return std::bit_cast<float>((rng.gen() % 2 ? 0x80000000u : 0u) | field << 23 | mantissa);
 }
@@ -406,7 +355,7 @@ float float_with_field(Rng& rng, uint32_t field) {
 TEST_CASE("make_block_ray's triangle ray is the kernel's make_tri_ray, bit for bit", "[wide]") {
   // Directions whose components have every exponent field (zero, denormal, normal, huge, inf, NaN),
   // either sign, ties between their magnitudes (the axis choice) and -0.
-  Rng rng(23);
+  StdRng rng(23);
   size_t checked = 0, mismatches = 0;
   auto component = [&](int kind) {
     switch (kind) {
@@ -452,7 +401,7 @@ TEST_CASE("four-lane plane normals of the triangle blocks equal the kernel's, bi
   // Vertices whose edges have every exponent field (the scale's clamp at both ends, flushes to zero,
   // denormals), coincide (zero edges, the unused lanes' case), overflow to infinity, or hold an
   // infinity or a NaN (the lanes the kernel itself takes).
-  Rng rng(29);
+  StdRng rng(29);
   size_t checked = 0, mismatches = 0;
   auto coordinate = [&](int kind, uint32_t field) {
     switch (kind) {
@@ -499,7 +448,7 @@ TEST_CASE("triangle blocks: every lane gives the scalar kernel's hit, from denor
   // lsk::ray_triangle, one lane at a time: triangles whose offsets from the origin have exponents
   // across the float range, coincide with the origin, share it as a vertex, or hold an infinity or
   // a NaN.  Expected from the kernel and offer_hit, as lsk::TraceContext::trace_leaf does.
-  Rng rng(17);
+  StdRng rng(17);
   const uint32_t ids[4] = {0u, 1u, 2u, 3u};
   lsk::TraceContext c{};
   c.tri_ids = ids;
@@ -761,13 +710,13 @@ void check_least_cost(const ls::Accel& a, const std::string& what) {
 }
 
 TEST_CASE("exact wide tree: each entry's collapse costs the least of all collapses (by exhaustion), 4 and 8 wide", "[wide]") {
-  Rng rng(5);
+  StdRng rng(5);
   for (int k = 0; k < 4; ++k) {  // triangle soups of 40 to 160, dense (merged leaves) and sparse
     ls::Scene scene;
     scene.name = "soup";
     scene.materials.push_back(ls::Material{});
-    scene.meshes.push_back(soup(size_t(40 + 40 * k), rng, 1.0f, k % 2 == 0 ? 0.3f : 0.05f));
-    scene.meshes.push_back(grid(3 + k));  // flat boxes
+    scene.meshes.push_back(with_face_normals(scattered_soup(rng, size_t(40 + 40 * k), 1.0f, k % 2 == 0 ? 0.3f : 0.05f)));
+    scene.meshes.push_back(with_face_normals(square_grid(3 + k, 0.0f, 1.0f)));  // flat boxes
     for (uint32_t i = 0; i < uint32_t(8 + 16 * k); ++i) {  // a top level of 8 to 56 instances
       ls::Instance inst;
       inst.mesh = i % 2;
