@@ -315,7 +315,8 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
   AccelOptions big_only = paper();
   big_only.ls.min_triangles = 1000;
   CHECK(build_accel(soup, parse_structure("f-ls:0:2"), big_only).ls_info.ls_nodes == 0);
-  // The default skips subtrees of fewer than 8 triangles (measured: docs/performance.md, "Line Space parameters"); the paper's 0 keeps them.
+  // The default skips subtrees of fewer than 8 triangles (measured: docs/performance.md, "Line Space
+  // parameters"); the paper's 0 keeps them.
   const Accel deep_default = build_accel(soup, parse_structure("f-ls:7:2"));
   const Accel deep_paper = build_accel(soup, parse_structure("f-ls:7:2"), paper());
   REQUIRE(deep_paper.ls_info.ls_nodes > deep_default.ls_info.ls_nodes);

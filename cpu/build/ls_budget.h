@@ -10,8 +10,9 @@
 //          more than 1e-3 of the scene's diagonal away; for shadow rays: occluded or not changed),
 //          over all pilot rays;
 //   work   box tests + 2.3 x triangle tests + 5.7 x Line Space lookups of those rays (the weights
-//          are the reference traversal's instruction costs, measured: docs/performance.md, "Per-object Line Space ..."); the
-//          option's saved work is the exact traversal's minus its own.
+//          are the reference traversal's instruction costs, measured: docs/performance.md,
+//          "Per-object Line Space under a memory budget"); the option's saved work is the exact
+//          traversal's minus its own.
 //   bytes  its LS nodes and candidates, exactly as the builder lays them out.
 // Summed over objects, the plan minimises the error subject to
 //   bytes_ls <= budget, and saved work >= that of the reference, the uniform 2l-ls:D:N of the menu

@@ -16,8 +16,9 @@ namespace ls {
 lsk::Hit trace_ray(const lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 lsk::Hit trace_ray_counted(lsk::TraceContext& context, const Accel& accel, const lsk::Ray& ray, bool any_hit);
 
-// Traces a batch on all threads (TBB) with accel.traversal, Line Space lookups as `lookup` says; Line Space counters are added to *counters
-// when given.  The second form names the traversal (bench and tests run both on one structure).
+// Traces a batch on all threads (TBB) with accel.traversal, every Line Space lookup as `lookup` says;
+// Line Space counters are added to *counters when given.  The second form names the traversal (bench
+// and tests run both on one structure).
 void trace_rays(const Accel& accel, const LsLookup& lookup, const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit,
                 lsk::LsCounters* counters = nullptr);
 // The reference traversal's work over a batch (the 2l-ls:auto pilot's model, ls_budget.h): box and
@@ -29,7 +30,8 @@ struct TraceWorkTotals {
   uint64_t box_tests_in_ls = 0, triangle_tests_in_ls = 0;
 };
 // That work in box tests: a triangle test and a Line Space lookup weighed by instruction counts of the
-// reference traversal fitted over seven structures (docs/performance.md, "Per-object Line Space under a memory budget").
+// reference traversal fitted over seven structures (docs/performance.md, "Per-object Line Space under
+// a memory budget").
 constexpr double kTriangleTestWork = 2.3;
 constexpr double kLookupWork = 5.7;
 inline double work_units(uint64_t box_tests, uint64_t triangle_tests, uint64_t lookups) {
