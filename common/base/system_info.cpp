@@ -1,6 +1,5 @@
 #include "common/base/system_info.h"
 
-
 #include <fstream>
 
 namespace ls {

@@ -1,6 +1,5 @@
 #include "common/render/render_types.h"
 
-
 #include <algorithm>
 #include <limits>
 

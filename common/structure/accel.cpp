@@ -1,6 +1,5 @@
 #include "common/structure/accel.h"
 
-
 #include <cmath>
 
 namespace ls {
@@ -23,7 +22,6 @@ size_t Accel::bytes_ls() const {
   return node_ls.size() * sizeof(uint32_t) + ls_nodes.size() * sizeof(lsk::LsNode) +
          ls_candidates.size() * sizeof(uint32_t) + tri_normals.size() * sizeof(glm::uvec4);
 }
-
 
 size_t Accel::bytes_total() const {
   return nodes.size() * sizeof(lsk::BvhNode) + tris.size() * sizeof(lsk::Triangle) +
@@ -55,7 +53,6 @@ lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
   }
   return c;
 }
-
 
 void add_counters(lsk::LsCounters& into, const lsk::LsCounters& from) {
   into.lookups += from.lookups;

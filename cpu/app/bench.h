@@ -47,5 +47,4 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
                       int repeats, const AccelOptions& options = {}, const LsLookup& lookup = {}, bool any_hit = false,
                       const std::string& embree_isa = "best");
 
-
 }  // namespace ls

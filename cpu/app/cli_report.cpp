@@ -113,5 +113,4 @@ void print_counters(const lsk::LsCounters& c) {
                c.refused_angle, c.refused_behind, c.refused_beyond, c.refused_parallel, c.refused_no_shaft);
 }
 
-
 }  // namespace ls

@@ -16,7 +16,6 @@
 namespace ls {
 namespace {
 
-
 Bounds triangle_bounds(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   Bounds box;
   box.grow(a);
@@ -131,6 +130,12 @@ void build_two_level(const Scene& scene, const BvhBuildOptions& options, Accel& 
   build_top_level(scene, options, accel);
 }
 
+// A 2l-ls:auto structure is built from its plan (options.ls.objects), which build_accel never makes.
+void require_plan(const StructureSpec& spec, const AccelOptions& options) {
+  if (spec.budgeted && options.ls.objects.empty())
+    throw InputError("structure '2l-ls:auto' needs its plan before it is built (build_planned_accel, build_structures.h)");
+}
+
 }  // namespace
 
 Accel build_bvhs(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) {
@@ -154,8 +159,7 @@ Accel build_bvhs(const Scene& scene, const StructureSpec& spec, const AccelOptio
 
 void finish_accel(const Scene& scene, const AccelOptions& options, Accel& accel) {
   const StructureSpec& spec = accel.spec;
-  if (spec.budgeted && options.ls.objects.empty())
-    throw InputError("structure '2l-ls:auto' needs its plan before it is built (build_planned_accel, ls_budget.h)");
+  require_plan(spec, options);
   const auto start = std::chrono::steady_clock::now();
   double ls_layout_seconds = 0.0;
   if (spec.line_space()) {
@@ -180,8 +184,7 @@ void finish_accel(const Scene& scene, const AccelOptions& options, Accel& accel)
 }
 
 Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options) {
-  if (spec.budgeted && options.ls.objects.empty())
-    throw InputError("structure '2l-ls:auto' needs its plan before it is built (build_planned_accel, ls_budget.h)");
+  require_plan(spec, options);
   Accel accel = build_bvhs(scene, spec, options);
   finish_accel(scene, options, accel);
   return accel;

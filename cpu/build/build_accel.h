@@ -1,6 +1,6 @@
 // Builds any of the four structures of docs/design.md §3: the BVHs (cpu/build/bvh_builder.h), the
 // Line Space's layout (line_space_builder.h), the fast path's trees (cpu/trace/fast_tracer.h), then
-// the candidate search on them.  A 2l-ls:auto structure needs its plan first (ls_budget.h).
+// the candidate search on them.  A 2l-ls:auto structure needs its plan first (build_structures.h).
 #pragma once
 
 #include "common/model/scene.h"
@@ -10,7 +10,7 @@
 namespace ls {
 
 // Builds any of the four structures of docs/design.md §3.  A 2l-ls:auto structure must come with its
-// plan in options.ls.objects (build_planned_accel, ls_budget.h, makes both); InputError otherwise.
+// plan in options.ls.objects (build_planned_accel, build_structures.h, makes both); InputError otherwise.
 Accel build_accel(const Scene& scene, const StructureSpec& spec, const AccelOptions& options = {});
 
 // The two halves of build_accel, for the 2l-ls:auto planner, which plans on the BVHs in between:

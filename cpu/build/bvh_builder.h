@@ -12,7 +12,6 @@
 
 namespace ls {
 
-
 struct BvhBuildResult {
   std::vector<lsk::BvhNode> nodes;  // root at 0; inner nodes' children adjacent
   std::vector<uint32_t> order;      // order[i] = input index of the primitive at position i

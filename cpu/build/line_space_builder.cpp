@@ -90,7 +90,6 @@ void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees,
   });
 }
 
-
 size_t estimate_line_space_bytes(size_t ls_nodes, int n) {
   const double shafts = 30.0 * std::pow(double(n), 4.0);
   return size_t(double(ls_nodes) * (shafts * 4.0 + double(sizeof(lsk::LsNode))));

@@ -18,9 +18,6 @@ namespace ls {
 
 struct Accel;
 
-
-
-
 // Adds the Line Space to an exact structure that build_accel() made: layout_line_space(), then the
 // candidate search on all CPU threads, packed by pack_ls_candidates().  Throws InputError when the
 // estimated memory exceeds the budget, before allocating anything large.
@@ -78,7 +75,6 @@ uint32_t ls_search_instance(const Accel& accel);
 
 // Bytes the Line Space of `ls_nodes` nodes at subdivision n would take (candidates at 4 bytes).
 size_t estimate_line_space_bytes(size_t ls_nodes, int n);
-
 
 // How many Line Spaces layout_line_space_nodes() has laid out in this process (every CPU or GPU build,
 // and every 2l-ls:auto pilot evaluation, goes through it): the animation tests check that a

@@ -37,10 +37,6 @@
 
 namespace ls {
 
-
-
-
-
 // The menu of (D, N) an object can get.
 std::vector<ObjectLs> ls_budget_menu();
 
