@@ -45,7 +45,7 @@ TEST_CASE("linespace-gpu bad input exits 2 with a one-line reason", "[gpu_cli]")
       "frobnicate",
       // The CPU fast path's flags: the device traces with the shared kernels, so they are refused.
       "build --exact-width 4",
-      "bench --wide-width 8",
+      "bench --exact-width 8",
       "render --traversal reference --size 8x8 --out " + temp("r").string(),
   };
   for (const std::string& args : cases) {
@@ -173,12 +173,12 @@ TEST_CASE("linespace-gpu shards merged, alone or with a CPU shard, equal linespa
                                  "1-of-3.exr " + gpu + "2-of-3.exr");
   INFO(m.err);
   REQUIRE(m.status == 0);
-  require_same_render(temp("shards/single"), temp("shards/merged_gpu"), 3);
+  require_same_render(temp("shards/single"), temp("shards/merged_gpu"), 3, false);
   m = run(LINESPACE_CPU, "merge --out " + temp("shards/merged_mixed").string() + " " + temp("shards/cpu").string() +
                              "/partial-shard-0-of-3.exr " + gpu + "1-of-3.exr " + gpu + "2-of-3.exr");
   INFO(m.err);
   REQUIRE(m.status == 0);
-  require_same_render(temp("shards/single"), temp("shards/merged_mixed"), 3);
+  require_same_render(temp("shards/single"), temp("shards/merged_mixed"), 3, false);
   const auto report = nlohmann::json::parse(slurp(temp("shards/merged_mixed/report.json")));
   CHECK(report.at("device").get<std::string>().find("; ") != std::string::npos);  // both devices named
 }

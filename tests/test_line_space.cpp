@@ -340,7 +340,7 @@ TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes inc
   }
 }
 
-TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, and nothing is refused as behind", "[line_space]") {
+TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, which refuses fewer as behind", "[line_space]") {
   const Scene scene = single_mesh_scene(unit_cube_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
   const LsLookup reverse = angle(89.0f, true);
@@ -350,8 +350,10 @@ TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, an
     const Accel a = build_accel(scene, parse_structure(name), paper());  // one build: the lookup alone differs
     trace_all(a, rays, false, &exact_counters, angle(89.0f));
     const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &reverse_counters, reverse);
+    // Behind the origin answers with reverse; before the node's box (an origin outside it) refuses
+    // in both modes.
     REQUIRE(exact_counters.refused_behind > 0);
-    CHECK(reverse_counters.refused_behind == 0);
+    CHECK(reverse_counters.refused_behind < exact_counters.refused_behind);
     // The behind refusals became answers: more accepted or empty, the same lookups before them.
     CHECK(reverse_counters.accepted + reverse_counters.empty > exact_counters.accepted + exact_counters.empty);
     CHECK(require_in_interval(hits, rays) > 0);
@@ -361,6 +363,10 @@ TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, an
   REQUIRE(same_bits(trace_all(build_accel(scene, parse_structure("f-ls:3:6"), paper()), rays, false, nullptr, angle(0.0f, true)),
                     trace_all(build_accel(scene, parse_structure("bvh"), paper()), rays)));
 }
+
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+}  // namespace
 
 TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the reverse shaft's candidate answers, or says nothing is ahead", "[line_space]") {
   // Two parallel planes z = 0 and z = 1 and a wall at x = -0.9 that makes the box reach z = -1 .. 2,
@@ -459,21 +465,25 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
     uint32_t u_normal;
     glm::vec3 dir;
     float current_t;
+    float tmax;       // as launched
     uint32_t answer;  // with --ls-behind reverse
     uint32_t counter_offset;  // the LsCounters field it counts in
   };
   using C = lsk::TraceContext;
   const glm::vec3 upwards(0.2f, 0.1f, 1.0f);
   const std::vector<Case> cases = {
-      {"the plane ahead answers", horizontal(1.0f), up, upwards, lsk::ls_infinity(), C::LS_ACCEPTED, offsetof(lsk::LsCounters, accepted)},
-      {"within half a patch: the surface the ray leaves", horizontal(0.05f), up, upwards, lsk::ls_infinity(), C::LS_EMPTY,
+      {"the plane ahead answers", horizontal(1.0f), up, upwards, kInf, kInf, C::LS_ACCEPTED, offsetof(lsk::LsCounters, accepted)},
+      {"within half a patch: the surface the ray leaves", horizontal(0.05f), up, upwards, kInf, kInf, C::LS_EMPTY,
        offsetof(lsk::LsCounters, empty)},
-      {"past the box's exit: no surface in the box", horizontal(5.0f), up, upwards, lsk::ls_infinity(), C::LS_EMPTY,
+      {"past the box's exit: no surface in the box", horizontal(5.0f), up, upwards, kInf, kInf, C::LS_EMPTY,
        offsetof(lsk::LsCounters, empty)},
-      {"beyond the current hit: refused", horizontal(1.0f), up, upwards, 0.5f, C::LS_FALLBACK, offsetof(lsk::LsCounters, refused_beyond)},
-      {"past the refusal angle: refused", plane({0.8f, -1, -1}, {0.8f, 3, -1}, {0.8f, -1, 3}), along_x, upwards, lsk::ls_infinity(),
+      {"beyond the current hit: the answer all the same, which does not win", horizontal(1.0f), up, upwards, 0.5f, kInf,
+       C::LS_ACCEPTED, offsetof(lsk::LsCounters, accepted)},
+      {"beyond tmax as launched: refused", horizontal(1.0f), up, upwards, 0.5f, 0.5f, C::LS_FALLBACK,
+       offsetof(lsk::LsCounters, refused_beyond)},
+      {"past the refusal angle: refused", plane({0.8f, -1, -1}, {0.8f, 3, -1}, {0.8f, -1, 3}), along_x, upwards, kInf, kInf,
        C::LS_FALLBACK, offsetof(lsk::LsCounters, refused_angle)},
-      {"an empty reverse shaft (it starts on +X)", horizontal(1.0f), up, glm::vec3(0.5f, 0.0f, 0.6f), lsk::ls_infinity(), C::LS_EMPTY,
+      {"an empty reverse shaft (it starts on +X)", horizontal(1.0f), up, glm::vec3(0.5f, 0.0f, 0.6f), kInf, kInf, C::LS_EMPTY,
        offsetof(lsk::LsCounters, empty)},
   };
   for (const Case& k : cases) {
@@ -495,7 +505,9 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
       hit.t = k.current_t;
       hit.instance = hit.triangle = lsk::LS_INVALID;
       uint32_t prim = lsk::LS_INVALID;
-      const uint32_t answer = c.ls_lookup(0, origin, dir, lsk::safe_reciprocal(dir), 0.0f, lsk::LS_INVALID, hit, prim);
+      // The BVH node's box is the LS box here.
+      const uint32_t answer =
+          c.ls_lookup(0, node.lo, node.hi, origin, dir, lsk::safe_reciprocal(dir), 0.0f, k.tmax, lsk::LS_INVALID, hit, prim);
       uint32_t counted;
       std::memcpy(&counted, reinterpret_cast<const char*>(&c.ls_counters) + k.counter_offset, sizeof counted);
       if (reverse == 0u) {  // the documented default: behind the origin, refused
@@ -507,7 +519,10 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
       CHECK(counted == 1u);
       CHECK(c.ls_counters.lookups == 1u);
       CHECK(c.ls_counters.refused_behind == 0u);
-      if (answer == C::LS_ACCEPTED) {
+      if (answer == C::LS_ACCEPTED && k.current_t < 1.0f) {  // not closer than the current hit: not offered
+        CHECK(prim == lsk::LS_INVALID);
+        CHECK(hit.triangle == lsk::LS_INVALID);
+      } else if (answer == C::LS_ACCEPTED) {
         CHECK(prim == 1u);
         CHECK(hit.triangle == 1u);
         CHECK(hit.t == Approx((1.0f - 1e-4f) / dir.z).epsilon(1e-6));

@@ -42,30 +42,27 @@ TEST_CASE("structure estimates bound the bytes the built structures hold", "[bud
 }
 
 TEST_CASE("the fast path's bound covers its wide trees and blocks, and a structure without room for it is refused", "[budget]") {
-  // Every width pairing, flat and two-level, exact and Line Space, on a scene of unique meshes and
+  // Both widths, flat and two-level, exact and Line Space, on a scene of unique meshes and
   // on an instanced one.
   for (const char* scene_name : {"cornell", "generated:20000:7:3", "instances"}) {
     const Scene scene = builtin_scene(scene_name);
     for (const char* name : {"bvh", "2l-bvh", "f-ls:3:4", "2l-ls:2:3"}) {
       if (std::string(scene_name) == "instances" && !parse_structure(name).two_level()) continue;  // 3.3 million world triangles
-      for (int width : {4, 8})
-        for (int exact_width : {4, 8}) {
-          AccelOptions options;
-          options.wide_width = width;
-          options.exact_width = exact_width;
-          options.search_candidates = false;
-          const Accel accel = build_accel(scene, parse_structure(name), options);
-          const size_t bound = fast_path_bytes_at_most(accel, width, exact_width);
-          INFO(scene_name << " " << name << " widths " << width << "/" << exact_width << ": bound " << bound << ", built "
-                          << accel.bytes_wide());
-          CHECK(accel.bytes_wide() > 0);
-          CHECK(bound >= accel.bytes_wide());
-          CHECK(bound <= 4 * accel.bytes_wide());  // a bound, not a refusal of everything
-        }
+      for (int exact_width : {4, 8}) {
+        AccelOptions options;
+        options.exact_width = exact_width;
+        options.search_candidates = false;
+        const Accel accel = build_accel(scene, parse_structure(name), options);
+        const size_t bound = fast_path_bytes_at_most(accel, exact_width);
+        INFO(scene_name << " " << name << " width " << exact_width << ": bound " << bound << ", built " << accel.bytes_wide());
+        CHECK(accel.bytes_wide() > 0);
+        CHECK(bound >= accel.bytes_wide());
+        CHECK(bound <= 4 * accel.bytes_wide());  // a bound, not a refusal of everything
+      }
     }
   }
   // f-ls:3:4 on cornell: its parameter estimate (the BVH's build, the Line Space) fits a budget of
-  // exactly that estimate, the structure and its fast path together do not.
+  // exactly that estimate, the structure and its fast path's bound together do not.
   const Scene scene = builtin_scene("cornell");
   const StructureSpec spec = parse_structure("f-ls:3:4");
   AccelOptions options;
@@ -73,14 +70,14 @@ TEST_CASE("the fast path's bound covers its wide trees and blocks, and a structu
   options.ls.min_triangles = 1;
   options.search_candidates = false;
   const Accel fits = build_accel(scene, spec, options);
-  const size_t whole = fits.bytes_total() + fits.bytes_wide();
+  const size_t whole = fits.bytes_total() + fast_path_bytes_at_most(fits, options.exact_width);
   options.limits.max_memory = estimate_structure_bytes(scene, spec, options).total();
-  INFO("estimate " << options.limits.max_memory << ", structure and fast path " << whole);
+  INFO("estimate " << options.limits.max_memory << ", structure and fast path's bound " << whole);
   REQUIRE(options.limits.max_memory < whole);
   CHECK_THROWS_WITH(build_accel(scene, spec, options),
                     Contains("fast path") && Contains("triangle blocks") && Contains("over the budget") &&
                         Contains("--max-memory"));
-  options.limits.max_memory = whole + fast_path_bytes_at_most(fits, options.wide_width, options.exact_width);
+  options.limits.max_memory = whole;
   CHECK_NOTHROW(build_accel(scene, spec, options));
 }
 

@@ -115,14 +115,25 @@ CrossCheckResult cross_check_hits(const gpu::VulkanContext& context, const Scene
                                   const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options,
                                   const LsLookup& lookup) {
   const Accel accel = build_planned_accel(scene, spec, options);
+  // The CPU's reference kernel walks the device's order, so its Line Space counters are the device's
+  // too; the fast path walks order-free, so only its hits are compared.
   std::vector<lsk::Hit> cpu(rays.size());
   lsk::LsCounters cpu_counters{}, gpu_counters{};
-  trace_rays(accel, lookup, rays.data(), cpu.data(), rays.size(), any_hit, &cpu_counters);
+  trace_rays(accel, lookup, rays.data(), cpu.data(), rays.size(), any_hit, &cpu_counters, Traversal::Reference);
   gpu::GpuAccel uploaded(context, accel);
   gpu::GpuTracer tracer(context);
   tracer.set_rays(rays);
   const std::vector<lsk::Hit> gpu = tracer.trace(uploaded, lookup, any_hit, accel.spec.line_space() ? &gpu_counters : nullptr);
-  return compare_hit_arrays(cpu, gpu, cpu_counters, gpu_counters);
+  CrossCheckResult r = compare_hit_arrays(cpu, gpu, cpu_counters, gpu_counters);
+  if (accel.fast) {
+    std::vector<lsk::Hit> fast(rays.size());
+    trace_rays(accel, lookup, rays.data(), fast.data(), rays.size(), any_hit, nullptr, Traversal::Fast);
+    const CrossCheckResult f = compare_hit_arrays(fast, gpu, {}, {});
+    r.mismatches += f.mismatches;
+    for (const auto& m : f.first)
+      if (r.first.size() < 10) r.first.push_back({"fast path, " + m.where, m.cpu, m.gpu});
+  }
+  return r;
 }
 
 void print_cross_check(std::FILE* out, const std::string& what, const CrossCheckResult& result) {

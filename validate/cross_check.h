@@ -37,7 +37,8 @@ CrossCheckResult cross_check_candidates(const gpu::VulkanContext& context, const
                                         const AccelOptions& options = {});
 
 // Builds the structure once (CPU candidates, so a candidate difference cannot hide a traversal one)
-// and traces the rays on both back ends.
+// and traces the rays on both back ends: the device's hits and counters against the CPU reference
+// kernel's, and its hits against the CPU fast path's.
 CrossCheckResult cross_check_hits(const gpu::VulkanContext& context, const Scene& scene, const StructureSpec& spec,
                                   const std::vector<lsk::Ray>& rays, bool any_hit, const AccelOptions& options = {},
                                   const LsLookup& lookup = {});

@@ -86,8 +86,8 @@ struct LsCounters {
   uint empty;             // empty shaft: no hit in the subtree
   uint accepted;          // the candidate's plane gave the hit
   uint refused_angle;     // extrapolated normal too far from the ray
-  uint refused_behind;    // plane hit before tmin (behind the origin)
-  uint refused_beyond;    // plane hit after the current t (beyond tmax or a hit already found)
+  uint refused_behind;    // plane hit before the window: behind the origin (tmin), or before the node's box
+  uint refused_beyond;    // plane hit after the window: beyond tmax as launched, or past the node's box
   uint refused_parallel;  // ray parallel to the candidate's plane
   uint refused_no_shaft;  // line along a face of the LS box (enters and leaves through one face)
 };

@@ -42,7 +42,7 @@ LS_FN uint ls_find_candidate(uint node, IN(LsNode) ls, uint shaft, uint further_
     if (!ls_search_segment(ls, shaft, k, a, d)) continue;
     Hit hit = ls_search_hit();
     uint prim = LS_INVALID;
-    trace_bvh(node, a, d, 0.0f, instance, false, false, hit, prim);
+    trace_bvh(node, a, d, 0.0f, hit.t, instance, false, false, hit, prim);
     if (prim != LS_INVALID) return prim;
   }
   return LS_INVALID;

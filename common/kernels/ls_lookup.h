@@ -4,22 +4,32 @@
 //   negative: refuse everything, empty shafts included) and ls_reverse (non-zero: --ls-behind
 //   reverse, below), and the counters ls_counters.  N is the LS node's own (LsNode.n).
 //
-// Decided cases: the shaft comes from where the ray's *line* enters and leaves the LS box, so an
-// origin inside the box still finds its shaft.  An empty shaft means no hit in the subtree.  A
-// candidate is used as an infinite plane: the hit is refused, and the subtree traversed exactly, when
-// the ray is parallel to the plane, when the plane hit lies outside [tmin, current t] (behind the
-// origin, beyond tmax, or farther than a hit already found), when the line runs along a face of the
-// box (no shaft), or when the angle between the ray and the candidate's vertex normals extrapolated
-// to the plane hit exceeds the refusal angle.
+// A lookup's answer is a function of the ray and the node alone, never of the hit found so far, so
+// the closest hit is the same in any visiting order (order-free answers, docs/design.md §3):
+//  - accepted: the candidate's plane hit, when it lies in the node's *window*, the part of
+//    [tmin, tmax as launched] inside the node's own BVH box (the slab interval that box's pruning
+//    computes, widened by LS_ACCEPT_SLACK).  It is offered to the running hit like a triangle's;
+//  - empty: no hit in the subtree;
+//  - refused: the exact closest hit of the subtree, which the caller traverses.
+// The shaft comes from where the ray's *line* enters and leaves the LS box, so an origin inside the
+// box still finds its shaft.  A candidate is used as an infinite plane: refused when the ray is
+// parallel to the plane, when the plane hit lies outside the window (before the box or tmin, past
+// the box or tmax), when the line runs along a face of the box (no shaft), or when the angle between
+// the ray and the candidate's vertex normals extrapolated to the plane hit exceeds the refusal angle.
 //
-// --ls-behind reverse (ls_reverse): a plane hit behind the origin is not refused.  The shaft's
-// candidate is the first surface its line meets from the start patch; the *reverse* shaft's (end
-// patch to start patch, stored anyway) is the last, the one a ray from inside the box meets going
-// on.  So the reverse shaft's candidate answers instead, as an infinite plane like the first.  Its
-// plane hit within half a patch (half the line's chord through the box over N) of tmin, or behind
-// it, is the surface the ray leaves; past the line's exit from the box it is no surface in the box:
-// either way the shaft holds nothing ahead of the ray (empty, no hit in the subtree), and so does an
-// empty reverse shaft.  Otherwise beyond the current t, parallel or past the angle: refused as above.
+// --ls-behind reverse (ls_reverse): a plane hit behind the origin (before tmin) is not refused.  The
+// shaft's candidate is the first surface its line meets from the start patch; the *reverse* shaft's
+// (end patch to start patch, stored anyway) is the last, the one a ray from inside the box meets
+// going on.  So the reverse shaft's candidate answers instead, as an infinite plane like the first.
+// Its plane hit within half a patch (half the line's chord through the box over N) of tmin, or
+// behind it, is the surface the ray leaves; past the line's exit from the box it is no surface in
+// the box: either way the shaft holds nothing ahead of the ray (empty, no hit in the subtree), and
+// so does an empty reverse shaft.  Otherwise outside the window, parallel or past the angle: refused.
+
+// The relative slack of a lookup's window: without it, a flat box's window is a single rounded t,
+// and a quarter of its lookups were refused by rounding.  Below widen_distance's 2^-12, so that a
+// box the walk prunes (its entry beyond the widened current t) never holds an answer that would win.
+LS_CONST float LS_ACCEPT_SLACK = 1.220703125e-4f;  // 2^-13
 
 LS_CONST uint LS_FALLBACK = 0u;
 LS_CONST uint LS_EMPTY = 1u;
@@ -99,10 +109,27 @@ LS_FN uint ls_plane_hit(uint prim, IN(vec3) origin, IN(vec3) dir, float tmin, fl
   return LS_PLANE_HIT;
 }
 
-// One lookup at an LS node: LS_ACCEPTED (hit updated), LS_EMPTY (skip the subtree) or LS_FALLBACK
-// (traverse the subtree exactly).
-LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, float tmin, uint instance,
-                     INOUT(Hit) hit, INOUT(uint) hit_prim) {
+// The window of a lookup at the node whose BVH box is [box_lo, box_hi]: [window_lo, window_hi].
+LS_FN void ls_window(IN(vec3) origin, IN(vec3) inv_dir, IN(vec3) box_lo, IN(vec3) box_hi, float tmin, float tmax,
+                     OUT(float) window_lo, OUT(float) window_hi) {
+  vec3 tn;
+  vec3 tf;
+  slab_interval(origin.x, inv_dir.x, box_lo.x, box_hi.x, tn.x, tf.x);
+  slab_interval(origin.y, inv_dir.y, box_lo.y, box_hi.y, tn.y, tf.y);
+  slab_interval(origin.z, inv_dir.z, box_lo.z, box_hi.z, tn.z, tf.z);
+  float enter = max(max(tn.x, tn.y), tn.z);
+  float leave = min(min(tf.x, tf.y), tf.z);
+  precise float lo = enter - abs(enter) * LS_ACCEPT_SLACK;
+  precise float hi = leave + abs(leave) * LS_ACCEPT_SLACK;
+  window_lo = max(lo, tmin);
+  window_hi = min(hi, tmax);
+}
+
+// One lookup at an LS node whose BVH box is [box_lo, box_hi], for a ray launched with [tmin, tmax]:
+// LS_ACCEPTED (its plane hit offered to the running hit), LS_EMPTY (skip the subtree) or
+// LS_FALLBACK (traverse the subtree exactly).
+LS_FN uint ls_lookup(uint ls_index, IN(vec3) box_lo, IN(vec3) box_hi, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir,
+                     float tmin, float tmax, uint instance, INOUT(Hit) hit, INOUT(uint) hit_prim) {
   LsNode ls = ls_nodes[ls_index];
   ls_counters.lookups += 1u;
   // A refusal angle of 0 refuses every approximation, the "no hit" of an empty shaft included, so
@@ -123,22 +150,27 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
     ls_counters.empty += 1u;
     return LS_EMPTY;
   }
+  float window_lo;
+  float window_hi;
+  ls_window(origin, inv_dir, box_lo, box_hi, tmin, tmax, window_lo, window_hi);
   float t;
   float u;
   float v;
-  uint found = ls_plane_hit(prim, origin, dir, tmin, hit.t, t, u, v);
-  if (found == LS_PLANE_BEHIND && ls_reverse != 0u) {
+  uint found = ls_plane_hit(prim, origin, dir, window_lo, window_hi, t, u, v);
+  if (found == LS_PLANE_BEHIND && ls_reverse != 0u && t < tmin) {
     uint start_patch;
     uint end_patch;
     ls_shaft_patches(shaft, ls.n, start_patch, end_patch);
     prim = ls_candidate(ls, ls_shaft_index(end_patch, start_patch, ls.n));
     precise float half_patch = 0.5f * ls.inv_n * (t_out - t_in);
     precise float ahead = tmin + half_patch;
-    if (prim != LS_INVALID) found = ls_plane_hit(prim, origin, dir, ahead, hit.t, t, u, v);
+    if (prim != LS_INVALID) found = ls_plane_hit(prim, origin, dir, ahead, window_hi, t, u, v);
     if (prim == LS_INVALID || found == LS_PLANE_BEHIND || (found != LS_PLANE_PARALLEL && t > t_out)) {
       ls_counters.empty += 1u;
       return LS_EMPTY;
     }
+    // Ahead of the origin but before the node's box (an origin outside it): refused like the first.
+    if (found == LS_PLANE_HIT && t < window_lo) found = LS_PLANE_BEHIND;
   }
   if (found == LS_PLANE_PARALLEL) {
     ls_counters.refused_parallel += 1u;
@@ -156,8 +188,9 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_
     ls_counters.refused_angle += 1u;
     return LS_FALLBACK;
   }
+  // Only a hit as close as the current one meets the tie rule: offer_hit assumes t <= hit.t.
   uint inst = instance == LS_INVALID ? tri_instances[prim] : instance;
-  if (offer_hit(t, u, v, inst, tri_ids[prim], hit)) hit_prim = prim;
+  if (t <= hit.t && offer_hit(t, u, v, inst, tri_ids[prim], hit)) hit_prim = prim;
   ls_counters.accepted += 1u;
   return LS_ACCEPTED;
 }

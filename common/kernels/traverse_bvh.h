@@ -11,6 +11,8 @@
 //   instances[]      InstanceRecord, in top-level BVH order (2L only)
 //   node_ls[]        uint      LS node of each BVH node, or LS_INVALID (LS structures only)
 //   ls_enabled       uint      non-zero: use the Line Space (see ls_lookup.h for the rest)
+//   walk_far_first   uint      non-zero: visit the farther child first (tests: the answers must not
+//                              depend on the order); a shader's is 0
 //   count_work(node, boxes, triangles)  counts the box and triangle tests made at nodes[node]
 //                    (LS_INVALID: at no object node, e.g. the top level): C++ sums them into a
 //                    TraceWork, split at the Line Space nodes; a shader's is empty
@@ -53,13 +55,14 @@ LS_FN void instance_ray(IN(InstanceRecord) rec, IN(vec3) origin, IN(vec3) dir, O
   object_dir = d;
 }
 
-// Traverses the BVH rooted at nodes[root] with a ray given in that BVH's space.  instance is the id
-// to report, or LS_INVALID to read it per triangle (flat structures).  With use_ls, a node that
-// carries a Line Space is answered by its lookup, and traversed exactly only when the lookup refuses.
-// hit_prim receives the tris[] index of the hit.  Returns true when any_hit is set and a hit was
-// found (the caller stops).
-LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint instance, bool any_hit, bool use_ls,
-                     INOUT(Hit) hit, INOUT(uint) hit_prim) {
+// Traverses the BVH rooted at nodes[root] with a ray given in that BVH's space, launched with
+// [tmin, tmax] (hit.t may be smaller already: another instance's hit).  instance is the id to report,
+// or LS_INVALID to read it per triangle (flat structures).  With use_ls, a node that carries a Line
+// Space is answered by its lookup, and traversed exactly only when the lookup refuses.  hit_prim
+// receives the tris[] index of the hit.  Returns true when any_hit is set and a hit was found (the
+// caller stops).
+LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, float tmax, uint instance, bool any_hit,
+                     bool use_ls, INOUT(Hit) hit, INOUT(uint) hit_prim) {
   TriRay tri_ray = make_tri_ray(origin, dir);
   vec3 inv_dir = safe_reciprocal(dir);
   uint stack_node[LS_STACK_SIZE];
@@ -73,7 +76,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
     BvhNode node = nodes[current];
     bool descend = true;
     if (use_ls && node_ls[current] != LS_INVALID) {
-      uint answer = ls_lookup(node_ls[current], origin, dir, inv_dir, tmin, instance, hit, hit_prim);
+      uint answer = ls_lookup(node_ls[current], node.lo, node.hi, origin, dir, inv_dir, tmin, tmax, instance, hit, hit_prim);
       if (answer == LS_ACCEPTED && any_hit) return true;
       descend = answer == LS_FALLBACK;
     }
@@ -91,7 +94,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
       bool hit_left = ray_box(origin, inv_dir, tmin, hit.t, nodes[left].lo, nodes[left].hi, t_left);
       bool hit_right = ray_box(origin, inv_dir, tmin, hit.t, nodes[right].lo, nodes[right].hi, t_right);
       if (hit_left && hit_right) {
-        bool left_first = t_left <= t_right;
+        bool left_first = (t_left <= t_right) != (walk_far_first != 0u);
         stack_node[sp] = left_first ? right : left;
         stack_t[sp] = left_first ? t_right : t_left;
         sp = sp + 1;
@@ -120,7 +123,7 @@ LS_FN bool trace_bvh(uint root, IN(vec3) origin, IN(vec3) dir, float tmin, uint 
 LS_FN Hit trace_flat(IN(Ray) ray, bool any_hit) {
   Hit hit = empty_hit(ray);
   uint prim = LS_INVALID;
-  trace_bvh(0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, any_hit, ls_enabled != 0u, hit, prim);
+  trace_bvh(0u, ray.origin, ray.dir, ray.tmin, ray.tmax, LS_INVALID, any_hit, ls_enabled != 0u, hit, prim);
   return finish_hit(hit);
 }
 
@@ -144,7 +147,8 @@ LS_FN Hit trace_two_level(IN(Ray) ray, bool any_hit) {
         vec3 o;
         vec3 d;
         instance_ray(rec, ray.origin, ray.dir, o, d);
-        if (trace_bvh(rec.root, o, d, ray.tmin, rec.instance, any_hit, ls_enabled != 0u, hit, prim)) return finish_hit(hit);
+        if (trace_bvh(rec.root, o, d, ray.tmin, ray.tmax, rec.instance, any_hit, ls_enabled != 0u, hit, prim))
+          return finish_hit(hit);
       }
     } else {
       uint left = node.first;

@@ -171,7 +171,6 @@ struct AccelOptions {
   Limits limits;                  // --max-memory: builds refuse what would not fit
   bool search_candidates = true;  // false: the Line Space is laid out with every shaft empty (GPU search)
   Traversal traversal = Traversal::Fast;  // what trace_rays uses for this structure
-  int wide_width = 4;                     // treelets (Line Space structures): 4 or 8, chosen by measurement
   int exact_width = 8;                    // the order-free walk's nodes: 4 or 8, chosen by measurement
   bool fast_path = true;  // false: no fast path is made, trace_rays takes the reference (the GPU port's builds)
   AccelOptions() = default;

@@ -27,6 +27,7 @@ struct TraceContext {
   uint ls_enabled = 0;
   float ls_cos2 = -1.0f;
   uint ls_reverse = 0;  // --ls-behind reverse (ls_lookup.h)
+  uint walk_far_first = 0;  // tests: the farther child first (traverse_bvh.h)
   LsCounters ls_counters{};  // the shader keeps these in a private variable too
   TraceWork trace_work{};    // box and triangle tests of the reference traversal (shaders count nothing)
   // Per node of nodes[], non-zero in a Line Space node's subtree (line_space_subtrees(), accel.h):

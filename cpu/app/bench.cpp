@@ -25,7 +25,6 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   result.repeats = std::max(1, repeats);
   result.cpu = cpu_model();
   result.isa = fast_path_isa();
-  result.wide_width = options.wide_width;
   result.exact_width = options.exact_width;
   result.any_hit = any_hit;
 

@@ -35,7 +35,6 @@ struct BenchResult {
   std::string cpu;          // CPU model from /proc/cpuinfo
   std::string isa;          // the fast path's SIMD instruction set
   std::string embree_isa;   // the one Embree ran (embree_effective_isa)
-  int wide_width = 0;
   int exact_width = 0;
   bool any_hit = false;
   std::vector<BenchEntry> results;  // the structures in the order asked, Embree last

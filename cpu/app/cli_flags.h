@@ -59,7 +59,6 @@ struct LsFlags {
   size_t ls_budget_rays = LsPlanOptions{}.rays;
   bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
   std::string traversal = "fast";
-  int wide_width = AccelOptions{}.wide_width;
   int exact_width = AccelOptions{}.exact_width;
   std::string refused_value;
   std::vector<std::pair<std::string, const CLI::Option*>> refused_flags;  // a program without the fast path: its flags, refused when given
@@ -70,13 +69,10 @@ struct LsFlags {
     if (fast_path_flags) {
       app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
           ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
-      app->add_option("--wide-width", wide_width, "treelet width of the fast path's ordered walk (Line Space structures): 4 or 8")
-          ->capture_default_str()->check(CLI::IsMember({4, 8}));
-      app->add_option("--exact-width", exact_width,
-                      "node width of the fast path's order-free walk (exact structures, below LS nodes): 4 or 8")
+      app->add_option("--exact-width", exact_width, "node width of the fast path's order-free walk: 4 or 8")
           ->capture_default_str()->check(CLI::IsMember({4, 8}));
     } else {  // parsed, then refused by options()
-      for (const char* flag : {"--traversal", "--wide-width", "--exact-width"})
+      for (const char* flag : {"--traversal", "--exact-width"})
         refused_flags.emplace_back(flag, app->add_option(flag, refused_value)->group(""));  // group "": not in --help
     }
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
@@ -117,7 +113,6 @@ struct LsFlags {
     o.plan.rays = ls_budget_rays;
     o.plan.lookup = lookup();  // 2l-ls:auto measures its plan with the lookup the renders use
     o.traversal = parse_traversal(traversal);
-    o.wide_width = wide_width;
     o.exact_width = exact_width;
     if (progress)
       o.ls.progress = [](size_t done, size_t total) {

@@ -38,7 +38,7 @@ void print_bench(const BenchResult& r, bool json) {
       results.push_back(j);
     }
     std::cout << nlohmann::json{{"rays", r.rays}, {"threads", r.threads}, {"repeats", r.repeats}, {"device", "cpu: " + r.cpu},
-                                {"isa", r.isa}, {"embree_isa", r.embree_isa}, {"wide_width", r.wide_width}, {"exact_width", r.exact_width}, {"any_hit", r.any_hit}, {"results", results}}
+                                {"isa", r.isa}, {"embree_isa", r.embree_isa}, {"exact_width", r.exact_width}, {"any_hit", r.any_hit}, {"results", results}}
                      .dump(2)
               << "\n";
     return;
@@ -46,9 +46,8 @@ void print_bench(const BenchResult& r, bool json) {
   std::printf("%zu rays (%s), %d thread%s, median of %d runs, %s\n", r.rays,
               r.any_hit ? "occlusion: fast path and Embree; any hit: reference" : "closest hit",
               r.threads, r.threads == 1 ? "" : "s", r.repeats, r.cpu.c_str());
-  std::printf("fast path: %d-wide order-free BVH, %d-wide LS treelets, %s; reference: the scalar single-source kernels; "
-              "Embree: %s\n",
-              r.exact_width, r.wide_width, r.isa.c_str(), r.embree_isa.c_str());
+  std::printf("fast path: %d-wide order-free BVH, %s; reference: the scalar single-source kernels; Embree: %s\n", r.exact_width,
+              r.isa.c_str(), r.embree_isa.c_str());
   std::printf("%-14s %10s %10s %10s %10s %9s %10s %9s %9s\n", "structure", "fast MR/s", "vs Embree", "vs bvh", "ref MR/s",
               "ref vs E", "fast/ref", "MB", "build ms");
   for (const BenchEntry& e : r.results) {

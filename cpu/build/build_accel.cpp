@@ -170,8 +170,8 @@ void finish_accel(const Scene& scene, const AccelOptions& options, Accel& accel)
   // search, which then runs on it.
   const auto wide_start = std::chrono::steady_clock::now();
   if (options.fast_path) {
-    check_fast_path_budget(accel, options.wide_width, options.exact_width, options.limits.max_memory);
-    accel.fast = make_fast_tracer(accel, options.wide_width, options.exact_width);
+    check_fast_path_budget(accel, options.exact_width, options.limits.max_memory);
+    accel.fast = make_fast_tracer(accel, options.exact_width);
     accel.fast_bytes = accel.fast->bytes();
   }
   accel.traversal = options.fast_path ? options.traversal : Traversal::Reference;

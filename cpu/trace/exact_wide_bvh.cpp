@@ -34,7 +34,9 @@ struct Collapser {
   // A lane for b is a leaf: a binary leaf, or a subtree of at most kLeafMax primitives that the
   // surface area heuristic prefers as one leaf (merge[b], see sah).
   std::vector<uint8_t> merge;
-  bool leaf_lane(uint32_t b) const { return !inner(b) || merge[b] != 0; }
+  // A Line Space node below the entry is a lane of its own; its merge[] belongs to its own entry.
+  bool ls_node(uint32_t b) const { return !node_ls.empty() && node_ls[b] != lsk::LS_INVALID; }
+  bool leaf_lane(uint32_t b) const { return ls_node(b) || !inner(b) || merge[b] != 0; }
 
   // The collapse of least expected cost, by the surface area heuristic (Ylitie, Karras and Laine,
   // "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017, section
@@ -62,13 +64,26 @@ struct Collapser {
     }
     Costs l;
     Costs r;
+    // A Line Space child is a lane of its own; more than kLeafMax primitives keeps it out of a leaf.
+    auto child = [&](uint32_t c, int levels, Costs& cost_c, uint32_t& prims_c) {
+      if (ls_node(c)) {
+        cost_c.fill(half_area(nodes[c]) * ExactWideTree<kWidth>::kLookupCost);
+        prims_c = ExactWideTree<kWidth>::kLeafMax + 1u;
+        return;
+      }
+      cost_c = sah(c, levels);
+      prims_c = prims[c];
+    };
+    uint32_t prims_l = 0;
+    uint32_t prims_r = 0;
     if (parallel_levels > 0)
-      ls::parallel_invoke([&] { l = sah(n.first, parallel_levels - 1); }, [&] { r = sah(n.first + 1, parallel_levels - 1); });
+      ls::parallel_invoke([&] { child(n.first, parallel_levels - 1, l, prims_l); },
+                          [&] { child(n.first + 1, parallel_levels - 1, r, prims_r); });
     else {
-      l = sah(n.first);
-      r = sah(n.first + 1);
+      child(n.first, 0, l, prims_l);
+      child(n.first + 1, 0, r, prims_r);
     }
-    const uint32_t count = prims[n.first] + prims[n.first + 1];
+    const uint32_t count = prims_l + prims_r;
     prims[b] = count;
     // j lanes divided between the children, k to the first: the cheapest k for each j.  k starts
     // at 1, so a cost that is not finite still leaves a valid division.
@@ -100,30 +115,6 @@ struct Collapser {
   }
   std::vector<uint32_t> prims;  // per node below an entry: its primitives (sah)
 
-  std::vector<uint8_t> has_ls;  // per node: 1 when a Line Space node lies in its subtree (itself included)
-
-  bool holds_ls(uint32_t b) const { return !has_ls.empty() && has_ls[b] != 0; }
-
-  void mark_ls(uint32_t b) {
-    if (inner(b)) {
-      mark_ls(nodes[b].first);
-      mark_ls(nodes[b].first + 1);
-    }
-    has_ls[b] = node_ls[b] != lsk::LS_INVALID || (inner(b) && (has_ls[nodes[b].first] || has_ls[nodes[b].first + 1]));
-  }
-
-  // The entries below b: b itself when nothing strictly below it carries a Line Space.
-  void find_entries(uint32_t b, std::vector<uint32_t>& out) const {
-    if (!inner(b)) return;
-    const uint32_t l = nodes[b].first;
-    if (!holds_ls(l) && !holds_ls(l + 1)) {
-      out.push_back(b);
-      return;
-    }
-    find_entries(l, out);
-    find_entries(l + 1, out);
-  }
-
   static double half_area(const lsk::BvhNode& n) {
     const double x = double(n.hi.x) - double(n.lo.x);
     const double y = double(n.hi.y) - double(n.lo.y);
@@ -135,6 +126,7 @@ struct Collapser {
   int children(uint32_t b, std::array<uint32_t, kWidth>& lanes) const {
     int n = 0;
     auto emit = [&](auto&& self, uint32_t x, int i) -> void {  // x as at most i lanes, as split says
+      if (ls_node(x)) i = 1;  // one lane, whatever more its parent's costs allowed (its split[] is its entry's)
       while (i > 1 && split[x][size_t(i - 1)] == 0) --i;
       if (i == 1) {
         lanes[size_t(n++)] = x;
@@ -196,7 +188,10 @@ struct Collapser {
         w.lo[a][i] = c.lo[a];
         w.hi[a][i] = c.hi[a];
       }
-      if (leaf_lane(lanes[size_t(i)])) {
+      if (ls_node(lanes[size_t(i)])) {
+        w.child[i] = lanes[size_t(i)];
+        w.count[i] = kLsLane;
+      } else if (leaf_lane(lanes[size_t(i)])) {
         const Range r = range(lanes[size_t(i)]);
         w.child[i] = r.first;
         w.count[i] = r.count;
@@ -218,15 +213,12 @@ ExactWideTree<W> build_exact_wide_tree(const std::vector<lsk::BvhNode>& nodes, c
                                        const std::vector<uint32_t>& roots, ExactLeaves leaves) {
   ExactWideTree<W> tree;
   tree.entry_of.assign(nodes.size(), lsk::LS_INVALID);
-  Collapser<W> c{nodes, node_ls, leaves, tree, {}, {}, {}, {}, {}};
+  Collapser<W> c{nodes, node_ls, leaves, tree, {}, {}, {}, {}};
   std::vector<uint32_t> entries;
-  if (!node_ls.empty()) {
-    c.has_ls.assign(nodes.size(), 0);
-    for (uint32_t r : roots)
-      if (r != lsk::LS_INVALID && r < nodes.size()) c.mark_ls(r);
-  }
   for (uint32_t r : roots)
-    if (r != lsk::LS_INVALID && r < nodes.size()) c.find_entries(r, entries);
+    if (r != lsk::LS_INVALID && r < nodes.size() && c.inner(r)) entries.push_back(r);
+  for (uint32_t b = 0; b < node_ls.size(); ++b)
+    if (c.ls_node(b) && c.inner(b)) entries.push_back(b);
   c.merge.assign(nodes.size(), 0);
   c.split.resize(nodes.size());
   c.prims.resize(nodes.size());

@@ -4,7 +4,6 @@
 #include "common/structure/accel.h"
 #include "cpu/trace/exact_wide_bvh.h"
 #include "cpu/trace/triangle_blocks.h"
-#include "cpu/trace/wide_bvh.h"
 
 #include <vector>
 
@@ -31,28 +30,24 @@ BvhShape bvh_shape(const std::vector<lsk::BvhNode>& nodes) {
 
 }  // namespace
 
-size_t fast_path_bytes_at_most(const Accel& accel, int width, int exact_width) {
+size_t fast_path_bytes_at_most(const Accel& accel, int exact_width) {
   const size_t exact_node = exact_width == 8 ? sizeof(ExactWideNode<8>) : sizeof(ExactWideNode<4>);
-  const size_t treelet_node = width == 8 ? sizeof(WideNode<3>) : sizeof(WideNode<2>);
-  const bool treelets = accel.spec.line_space();
   // Each order-free node is made from a distinct binary inner node (the collapse picks its lanes
   // among that node's descendants).
   const BvhShape object = bvh_shape(accel.nodes);
   size_t bytes = object.inner * exact_node + object.blocks * sizeof(TriBlock) +
                  2 * object.nodes * sizeof(uint32_t);  // entry_of, lane_of
-  if (treelets) bytes += object.inner * treelet_node + object.nodes * sizeof(uint32_t);  // wide_of
   if (accel.spec.two_level()) {
     const BvhShape top = bvh_shape(accel.top_nodes);
     bytes += top.inner * exact_node + top.nodes * sizeof(uint32_t);
-    if (treelets) bytes += top.inner * treelet_node + top.nodes * sizeof(uint32_t);
   }
   return bytes;
 }
 
-void check_fast_path_budget(const Accel& accel, int width, int exact_width, size_t max_memory) {
+void check_fast_path_budget(const Accel& accel, int exact_width, size_t max_memory) {
   const size_t budget = memory_budget(max_memory);
   const size_t built = accel.bytes_total();
-  const size_t fast = fast_path_bytes_at_most(accel, width, exact_width);
+  const size_t fast = fast_path_bytes_at_most(accel, exact_width);
   if (built <= budget && fast <= budget - built) return;
   throw InputError("the fast path of structure '" + accel.spec.name() + "' (its wide trees and triangle blocks) would take up to " +
                    mib_text(double(fast)) + " beside the structure's " + mib_text(double(built)) + ", over the budget of " +

@@ -5,7 +5,6 @@
 #include "cpu/trace/simd.h"
 #include "cpu/trace/reference_trace.h"
 #include "cpu/trace/triangle_blocks.h"
-#include "cpu/trace/wide_bvh.h"
 
 #include <bit>
 #include <cmath>
@@ -118,132 +117,10 @@ LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, cons
                        Batch(lsk::LS_WIDEN_SLACK);
 }
 
-// slab_tests with its per-ray choices made once per call: a ray parallel to no slab (nearly all)
-// runs straight-line code.
-template <bool kBySign, class Batch>
-LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
-                                 Batch& widened) {
-  if (r.any_parallel)
-    slab_tests<kBySign, true>(rows, r, tmin, tmax, near, widened);
-  else
-    slab_tests<kBySign, false>(rows, r, tmin, tmax, near, widened);
-}
-
-// The box tests of every lane of a treelet: entry distances and widened exit distances.
-template <int K>
-LS_ALWAYS_INLINE void box_tests(const WideNode<K>& node, const SlabRay<FloatBatch>& r, const FloatBatch& tmin, float tmax, float* tnear,
-                      float* tfar) {
-  const FloatBatch tmax_batch(tmax);
-  for (int c = 0; c < WideNode<K>::kPadded; c += int(FloatBatch::size)) {
-    FloatBatch near;
-    FloatBatch widened;
-    const char* rows = reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c);
-    if (r.by_sign)
-      slab_tests<true>(rows, r, tmin, tmax_batch, near, widened);
-    else
-      slab_tests<false>(rows, r, tmin, tmax_batch, near, widened);
-    near.store_aligned(tnear + c);
-    widened.store_aligned(tfar + c);
-  }
-}
-
 // lsk::widen_distance with |t| taken by clearing the sign bit: glm's abs (t >= 0 ? t : -t) is a
 // branch, which a walk's pops mispredicted about once a ray.  The two differ only in the sign of a
 // zero or a NaN, which no comparison sees.
 LS_ALWAYS_INLINE float widen_limit(float t) { return t + std::fabs(t) * lsk::LS_WIDEN_SLACK; }
-
-// What a node visit asks of the traversal.
-enum class Visit { Descend, Skip, Stop };
-
-// The reference's loop (trace_bvh / trace_two_level), node for node, on a wide tree.  Starts at the
-// treelet root of wide node w (its box already tested by the caller).  visit(ls, leaf, first, count,
-// block, entry) is called for every node the reference visits (entry: an inner node's order-free
-// entry, exact_wide_bvh.h): an inner node (leaf = false) is descended only on Visit::Descend;
-// Visit::Stop ends the walk and returns true.
-//
-// Each wide node's boxes are tested once, when the walk enters it, against the current t = h0; later
-// decisions at its inner positions (after a pop, with a smaller current t = h) reuse them.  This is
-// exact: the reference tests tnear <= widen(min(tf, h)), tnear does not depend on t, and widen is
-// monotone, so for h <= h0 that is tnear <= widen(min(tf, h0)) && tnear <= widen(h).  (A NaN tmax is
-// ignored by the reference's min and never changes: the second test is then skipped.)  The walk is
-// depth first, so a node's results sit in the slot of its wide depth until every pending position of
-// it has been popped.
-template <int K, class VisitFn>
-inline bool walk(const WideTree<K>& tree, uint w, const SlabRay<FloatBatch>& ray, float tmin, const Hit& hit, VisitFn&& visit) {
-  const FloatBatch tmin_batch(tmin);
-  using Node = WideNode<K>;
-  constexpr int kMaxDepth = lsk::TraceContext::LS_STACK_SIZE / K + 1;
-  alignas(64) float tnear[kMaxDepth][Node::kPadded];
-  alignas(64) float tfar[kMaxDepth][Node::kPadded];
-  const bool nan_t = hit.t != hit.t;
-  uint stack_w[lsk::TraceContext::LS_STACK_SIZE];
-  uint stack_pos[lsk::TraceContext::LS_STACK_SIZE];
-  int stack_depth[lsk::TraceContext::LS_STACK_SIZE];
-  float stack_t[lsk::TraceContext::LS_STACK_SIZE];
-  int sp = 0;
-  uint pos = 1;
-  int depth = 0;
-  while (true) {
-    const Node& node = tree.nodes[w];
-    const bool root = pos == 1;
-    const uint lane = pos - 2;
-    const bool leaf = !root && node.count[lane] > 0;
-    const Visit v = visit(root ? node.root_ls : node.ls[lane], leaf, leaf ? node.first[lane] : 0u, leaf ? node.count[lane] : 0u,
-                          leaf ? node.tri_lane[lane] : LS_INVALID, root ? node.root_exact : node.exact[lane]);
-    if (v == Visit::Stop) return true;
-    if (v == Visit::Descend && !leaf) {
-      if (root) {
-        box_tests(node, ray, tmin_batch, hit.t, tnear[depth], tfar[depth]);
-      }
-      const float* tn = tnear[depth];
-      const float* tf = tfar[depth];
-      const float limit = widen_limit(hit.t);
-      const uint c0 = 2u * pos;
-      const uint c1 = c0 + 1u;
-      const float tn0 = tn[c0 - 2u];
-      const float tn1 = tn[c1 - 2u];
-      const bool hit0 = tn0 <= tf[c0 - 2u] && (nan_t || tn0 <= limit);
-      const bool hit1 = tn1 <= tf[c1 - 2u] && (nan_t || tn1 <= limit);
-      // A bottom-level inner node continues as the root of its own wide node, one wide level down.
-      auto go = [&](uint c, uint& to_w, uint& to_pos, int& to_depth) {
-        if (c >= Node::kBottom && node.count[c - 2u] == 0u) {
-          to_w = node.first[c - 2u];
-          to_pos = 1u;
-          to_depth = depth + 1;
-        } else {
-          to_w = w;
-          to_pos = c;
-          to_depth = depth;
-        }
-      };
-      if (hit0 && hit1) {
-        const bool first0 = tn0 <= tn1;
-        go(first0 ? c1 : c0, stack_w[sp], stack_pos[sp], stack_depth[sp]);
-        stack_t[sp] = first0 ? tn1 : tn0;
-        ++sp;
-        go(first0 ? c0 : c1, w, pos, depth);
-        continue;
-      }
-      if (hit0 || hit1) {
-        go(hit0 ? c0 : c1, w, pos, depth);
-        continue;
-      }
-    }
-    // Pop the nearest pending node that can still hold something closer than the current hit.
-    bool found = false;
-    const float limit = widen_limit(hit.t);
-    while (sp > 0 && !found) {
-      --sp;
-      if (stack_t[sp] <= limit) {
-        w = stack_w[sp];
-        pos = stack_pos[sp];
-        depth = stack_depth[sp];
-        found = true;
-      }
-    }
-    if (!found) return false;
-  }
-}
 
 // The batch an exact W-wide node's boxes are tested in: 4 floats, or 8 where the build has AVX and
 // W = 8 (an 8-wide node on SSE2 takes two batches).
@@ -335,7 +212,7 @@ struct ExactWalk {
         const char* p = reinterpret_cast<const char*>(&tree.nodes[node.child[l]]);
         for (size_t line = 0; line < sizeof(ExactWideNode<W>); line += 64) __builtin_prefetch(p + line);
       } else {
-        prefetch_leaf(node.child[l]);
+        prefetch_leaf(node.child[l], node.count[l]);
       }
     };
     unsigned other = unsigned(std::countr_zero(lanes));
@@ -380,39 +257,36 @@ LS_ALWAYS_INLINE void walk_exact(const ExactWideTree<W>& tree, uint entry, const
     }
 }
 
-// What the fast path keeps of the object level: the treelets and the exact wide tree of the object
-// BVHs (or of the flat BVH) and the triangle blocks.  Shared by the tracers of every top level
-// (animation).
-template <int K, int W>
+// What the fast path keeps of the object level: the exact wide tree of the object BVHs (or of the
+// flat BVH) and the triangle blocks.  Shared by the tracers of every top level (animation).
+template <int W>
 struct ObjectPart {
   TriangleBlocks blocks;
   ExactWideTree<W> exact;
-  WideTree<K> tree;
 };
 
-// K: the treelets' binary levels (4 or 8 wide); W: the exact wide tree's width (4 or 8).
-template <int K, int W>
+// W: the wide trees' width (4 or 8).
+template <int W>
 class WideTracer final : public FastTracer {
  public:
-  // Only Line Space structures get treelets (their lookups need the reference's order).  An exact
-  // structure answers everything order-free but the reference's any hit (trace --any-hit), which
-  // its reference kernels answer; shadow rays are occlusion queries (occluded()).
-  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()), ordered_(accel.spec.line_space()) {
+  // Every query but the reference's any hit (trace --any-hit: the triangle it reports is the first
+  // in the reference's order), which the reference kernels answer, walks the wide trees order-free;
+  // shadow rays are occlusion queries (occluded()).
+  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()), line_space_(accel.spec.line_space()) {
     const std::vector<uint32_t> none;
-    const std::vector<uint32_t>& node_ls = accel.spec.line_space() ? accel.node_ls : none;
-    auto part = std::make_shared<ObjectPart<K, W>>();
+    const std::vector<uint32_t>& node_ls = line_space_ ? accel.node_ls : none;
+    auto part = std::make_shared<ObjectPart<W>>();
     const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
     part->exact = build_exact_wide_tree<W>(accel.nodes, node_ls, roots);
     part->blocks = build_triangle_blocks(accel.nodes, accel.tris, part->exact);
-    if (ordered_) part->tree = build_wide_tree<K>(accel.nodes, node_ls, roots, part->blocks.lane_of, part->exact.entry_of);
     if (two_level_) build_top(accel);
     part_ = std::move(part);
     blocks_ = part_->blocks.blocks.data();
   }
 
-  // The object part of `other`, new wide top trees over accel.top_nodes.
+  // The object part of `other`, a new wide top tree over accel.top_nodes.
   WideTracer(const WideTracer& other, const Accel& accel)
-      : two_level_(other.two_level_), ordered_(other.ordered_), part_(other.part_), blocks_(other.blocks_) {
+      : two_level_(other.two_level_), line_space_(other.line_space_), part_(other.part_), blocks_(other.blocks_) {
     build_top(accel);
   }
 
@@ -427,9 +301,7 @@ class WideTracer final : public FastTracer {
   }
 
   void occluded(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count) const override {
-    // With a Line Space the ordered walk stays: which lookups run before the first hit is in the
-    // counters, and those must be the reference's.
-    trace_all(c, rays, hits, count, c.ls_enabled != 0u ? Query::AnyHit : Query::Occlusion);
+    trace_all(c, rays, hits, count, Query::Occlusion);
   }
 
   void find_candidates(lsk::TraceContext& c, const lsk::LsNode& ls, const vec3* centres, uint32_t first, uint32_t end,
@@ -448,12 +320,12 @@ class WideTracer final : public FastTracer {
       vec3 d;
       if (c.ls_segment(a, centres[end_patch_s], d)) {  // search ray 0 joins the patch centres
         Hit hit = c.ls_search_hit();
-        trace_bvh<true>(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+        trace_bvh<true>(c, ls.node, a, d, 0.0f, hit.t, instance, Query::Closest, false, hit, prim);
       }
       for (uint k = 1u; k <= further_rays && prim == LS_INVALID; ++k) {
         if (!c.ls_search_segment(ls, s, k, a, d)) continue;
         Hit hit = c.ls_search_hit();
-        trace_bvh<true>(c, ls.node, a, d, 0.0f, instance, Query::Closest, false, hit, prim);
+        trace_bvh<true>(c, ls.node, a, d, 0.0f, hit.t, instance, Query::Closest, false, hit, prim);
       }
       prims[s - first] = prim;
       if (++end_rank == 5u * nn) {
@@ -463,19 +335,12 @@ class WideTracer final : public FastTracer {
     }
   }
 
-  size_t bytes() const override {
-    return part_->tree.bytes() + part_->exact.bytes() + part_->blocks.bytes() + top_.bytes() + top_exact_.bytes();
-  }
-  int width() const override { return 1 << K; }
+  size_t bytes() const override { return part_->exact.bytes() + part_->blocks.bytes() + top_exact_.bytes(); }
   int exact_width() const override { return W; }
 
  private:
-  // The top level: the exact wide tree, whose leaf lanes hold their first instance, and for Line
-  // Space structures the treelets.
-  void build_top(const Accel& accel) {
-    top_exact_ = build_exact_wide_tree<W>(accel.top_nodes, {}, {0u}, ExactLeaves::Instances);
-    if (ordered_) top_ = build_wide_tree<K>(accel.top_nodes, {}, {0u}, {}, {});
-  }
+  // The top level: the exact wide tree, whose leaf lanes hold their first instance.
+  void build_top(const Accel& accel) { top_exact_ = build_exact_wide_tree<W>(accel.top_nodes, {}, {0u}, ExactLeaves::Instances); }
 
   // What a trace asks: the closest hit, the reference's any hit (the first in its order), or only
   // whether anything is hit (some hit, found in any order: the fast path's shadow rays).
@@ -485,7 +350,7 @@ class WideTracer final : public FastTracer {
     for (size_t i = 0; i < count; ++i) {
       const lsk::Ray& ray = rays[i];
       // A flat structure's trace_bvh makes this choice itself; the top walk of a two-level one does not.
-      if (two_level_ && !ordered_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
+      if (two_level_ && (q == Query::AnyHit || !order_free_ray(ray.origin, ray.dir, ray.tmin)))
         hits[i] = trace_ray_reference(c, ray, true, q != Query::Closest);
       else
         hits[i] = two_level_ ? trace_two_level(c, ray, q) : trace_flat(c, ray, q);
@@ -509,104 +374,99 @@ class WideTracer final : public FastTracer {
     }
   };
 
-  // The order-free walk below `entry`, leaves tested against tri_ray().  True: an occlusion query's
-  // hit (any_hit is one here: the reference's any hit never walks order-free).
-  LS_ALWAYS_INLINE bool run_exact(lsk::TraceContext& c, uint entry, const ExactBoxRay<W>& exact_ray, LazyBlockRay& tri_ray,
-                                  float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
+  // One query in one BVH (the flat one, or an instance's object): the ray as the walks need it.
+  struct ObjectQuery {
+    const vec3& origin;
+    const vec3& dir;
+    vec3 inv_dir;
+    float tmin;
+    float tmax;  // as launched: a Line Space lookup's window
+    uint instance;
+    bool any_hit;
+    bool use_ls;
+    ExactBoxRay<W> exact_ray;
+    LazyBlockRay tri_ray;
+    ObjectQuery(const vec3& o, const vec3& d, const vec3& inv, float t0, float t1, uint inst, bool any, bool ls)
+        : origin(o), dir(d), inv_dir(inv), tmin(t0), tmax(t1), instance(inst), any_hit(any), use_ls(ls), tri_ray(o, d) {
+      init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, o, inv, true);
+    }
+  };
+
+  // The order-free walk below `entry`, leaves tested against tri_ray(), Line Space lanes (kLs: a
+  // Line Space structure) answered by ls_node.  True: an occlusion query's hit (any_hit is one
+  // here: the reference's any hit never walks order-free).
+  template <bool kLs>
+  LS_ALWAYS_INLINE bool run_exact(lsk::TraceContext& c, uint entry, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
     bool stopped = false;
     auto run = [&](auto&& ray_for_leaf) LS_ALWAYS_LAMBDA {
       walk_exact(
-          part_->exact, entry, exact_ray, tmin, hit,
-          [&](uint lane, uint n) {
-            return stopped = trace_blocks(c, blocks_, lane, n, ray_for_leaf(), tmin, instance, any_hit, hit, hit_prim);
+          part_->exact, entry, q.exact_ray, q.tmin, hit,
+          [&](uint child, uint n) {
+            if (kLs && n == kLsLane) return stopped = ls_node(c, child, q, hit, hit_prim);
+            return stopped = trace_blocks(c, blocks_, child, n, ray_for_leaf(), q.tmin, q.instance, q.any_hit, hit, hit_prim);
           },
-          [&](uint lane) { prefetch_block(lane / 4u); });
+          [&](uint child, uint n) {
+            if (!kLs || n != kLsLane) prefetch_block(child / 4u);
+          });
     };
-    if (instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
-      const BlockRay& tr = tri_ray();
+    if (q.instance == LS_INVALID) {  // flat: nearly every walk reaches a leaf
+      const BlockRay& tr = q.tri_ray();
       run([&]() -> const BlockRay& { return tr; });
     } else {  // an instance's object: many walks end before any leaf
-      run(tri_ray);
+      run(q.tri_ray);
     }
     return stopped;
   }
 
-  // A query that is one order-free walk from the entry at the root (the entry's node tests the
-  // root's children, which pass only where the root would): an exact structure's, or an instance's
-  // object without a Line Space at its root.  Kept apart from the treelet walk's closures, whose
-  // stores cost about 20 instructions a ray before any box is tested.
-  LS_ALWAYS_INLINE bool trace_entry(lsk::TraceContext& c, uint entry, const vec3& origin, const vec3& dir, const vec3& inv_dir,
-                                    float tmin, uint instance, bool any_hit, Hit& hit, uint& hit_prim) const {
-    ExactBoxRay<W> exact_ray;
-    init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);
-    LazyBlockRay tri_ray{origin, dir};
-    return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
+  // The Line Space node at binary node b (a lane, or the root of a BVH): its lookup, and its
+  // subtree's exact walk where the lookup refuses (or use_ls is off).  True: an occlusion query's
+  // hit.  Out of line: the subtree's walk calls back into run_exact.
+  __attribute__((noinline)) bool ls_node(lsk::TraceContext& c, uint b, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
+    const lsk::BvhNode& node = c.nodes[b];
+    const uint ls = q.use_ls ? c.node_ls[b] : LS_INVALID;
+    if (ls != LS_INVALID) {
+      const uint answer =
+          c.ls_lookup(ls, node.lo, node.hi, q.origin, q.dir, q.inv_dir, q.tmin, q.tmax, q.instance, hit, hit_prim);
+      if (answer == lsk::TraceContext::LS_ACCEPTED) return q.any_hit && hit.triangle != LS_INVALID;
+      if (answer == lsk::TraceContext::LS_EMPTY) return false;
+    }
+    if (node.count > 0)
+      return trace_blocks(c, blocks_, part_->blocks.lane_of[b], node.count, q.tri_ray(), q.tmin, q.instance, q.any_hit, hit,
+                          hit_prim);
+    return run_exact<true>(c, part_->exact.entry_of[b], q, hit, hit_prim);
   }
 
-  // lsk::TraceContext::trace_bvh on the wide trees: the treelet walk in the reference's order, and
-  // the order-free walk below the entries it reaches, except for the reference's any hit.  Returns
-  // true when an any-hit or occlusion query found its hit (the caller stops).  Always inlined: GCC
-  // otherwise chose by a hair whether an instance's walk sat in the top walk or behind a call
-  // (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change elsewhere).  kSearch:
-  // the LS build's search gets its own copy of the walks it inlines; sharing them added a caller
-  // to the instance's exact walk, which GCC then left out of line (2l-bvh on generated 3,388 ->
-  // 3,483).
+  // lsk::TraceContext::trace_bvh on the wide trees: the order-free walk, except for the reference's
+  // any hit and rays outside the order-free walk's arithmetic (order_free_ray), which take the
+  // reference kernel.  Returns true when an any-hit or occlusion query found its hit (the caller
+  // stops).  Always inlined: GCC otherwise chose by a hair whether an instance's walk sat in the top
+  // walk or behind a call (2l-bvh on cornell 3,611 or 3,797 instructions a ray, from one change
+  // elsewhere).  kSearch: the LS build's search gets its own copy of the walks it inlines; sharing
+  // them added a caller to the instance's exact walk, which GCC then left out of line (2l-bvh on
+  // generated 3,388 -> 3,483).
   template <bool kSearch = false>
-  LS_ALWAYS_INLINE bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin,
+  LS_ALWAYS_INLINE bool trace_bvh(lsk::TraceContext& c, uint root, const vec3& origin, const vec3& dir, float tmin, float tmax,
                                   uint instance, Query q, bool use_ls, Hit& hit, uint& hit_prim) const {
     const bool any_hit = q != Query::Closest;
-    const bool order_free = q != Query::AnyHit && order_free_ray(origin, dir, tmin);
-    if (!order_free && !ordered_)  // no treelets: the reference kernel (e.g. an object ray that overflowed)
-      return trace_bvh_reference(c, root, origin, dir, tmin, instance, any_hit, use_ls, hit, hit_prim);
+    if (q == Query::AnyHit || !order_free_ray(origin, dir, tmin))
+      return trace_bvh_reference(c, root, origin, dir, tmin, tmax, instance, any_hit, use_ls, hit, hit_prim);
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
-    const uint root_ls = use_ls ? c.node_ls[root] : LS_INVALID;
+    ObjectQuery query(origin, dir, inv_dir, tmin, tmax, instance, any_hit, use_ls);
     const uint root_entry = part_->exact.entry_of[root];
-    if (order_free && root_entry != LS_INVALID && root_ls == LS_INVALID)
-      return trace_entry(c, root_entry, origin, dir, inv_dir, tmin, instance, any_hit, hit, hit_prim);
-    LazyBlockRay tri_ray{origin, dir};
-    ExactBoxRay<W> exact_ray;  // made once, at the first order-free walk
-    bool exact_ray_made = false;
-    auto exact = [&](uint entry) LS_ALWAYS_LAMBDA {  // true: an occlusion query's hit
-      if (!exact_ray_made) {
-        init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, origin, inv_dir, true);  // in place: no copy
-        exact_ray_made = true;
-      }
-      return run_exact(c, entry, exact_ray, tri_ray, tmin, instance, any_hit, hit, hit_prim);
-    };
-    // A call from the treelet walk: inlined there it outgrew GCC's budget (f-ls:8:6 on cornell
-    // 2,818 -> 3,045 instructions a ray).
-    auto exact_call = [&](uint entry) __attribute__((noinline)) { return exact(entry); };
+    const bool root_ls = line_space_ && c.node_ls[root] != LS_INVALID;
+    // The entry's node tests the root's children, which pass only where the root's box would.
+    if (root_entry != LS_INVALID && !root_ls)
+      return line_space_ ? run_exact<true>(c, root_entry, query, hit, hit_prim)
+                         : run_exact<false>(c, root_entry, query, hit, hit_prim);
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
-    auto visit = [&](uint ls, bool leaf, uint, uint count, uint tri_lane, uint entry) {
-      if (use_ls && ls != LS_INVALID) {
-        const uint answer = c.ls_lookup(ls, origin, dir, inv_dir, tmin, instance, hit, hit_prim);
-        if (answer == lsk::TraceContext::LS_ACCEPTED && any_hit) return Visit::Stop;
-        if (answer != lsk::TraceContext::LS_FALLBACK) return Visit::Skip;
-      }
-      if (leaf)
-        return trace_blocks(c, blocks_, tri_lane, count, tri_ray(), tmin, instance, any_hit, hit, hit_prim) ? Visit::Stop
-                                                                                                        : Visit::Skip;
-      if (!order_free || entry == LS_INVALID) return Visit::Descend;
-      return exact_call(entry) ? Visit::Stop : Visit::Skip;
-    };
-    const lsk::BvhNode& node = c.nodes[root];
-    if (node.count > 0)  // a root that is a leaf has no wide node
-      return visit(root_ls, true, node.first, node.count, part_->blocks.lane_of[root], LS_INVALID) == Visit::Stop;
-    if (order_free && root_entry != LS_INVALID)  // a Line Space at the root, then the whole tree order-free
-      return visit(root_ls, false, 0u, 0u, LS_INVALID, root_entry) == Visit::Stop;
-    // Out of line: inlined here, the treelet walk crowded the flat structure's own (f-ls:8:6 on
-    // fireplace 3,727 -> 4,107 instructions a ray, when the triangle blocks grew by block_distances).
-    return [&]() __attribute__((noinline)) {
-      return walk(part_->tree, part_->tree.wide_of[root],
-                  make_slab_ray<FloatBatch, WideNode<K>>(origin, inv_dir, order_free_ray(origin, dir, tmin)), tmin, hit, visit);
-    }();
+    return ls_node(c, root, query, hit, hit_prim);  // a Line Space at the root, or a root that is a leaf
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, Query q) const {
     Hit hit = lsk::empty_hit(ray);
     uint prim = LS_INVALID;
-    trace_bvh(c, 0u, ray.origin, ray.dir, ray.tmin, LS_INVALID, q, c.ls_enabled != 0u, hit, prim);
+    trace_bvh(c, 0u, ray.origin, ray.dir, ray.tmin, ray.tmax, LS_INVALID, q, c.ls_enabled != 0u, hit, prim);
     return lsk::finish_hit(hit);
   }
 
@@ -624,27 +484,19 @@ class WideTracer final : public FastTracer {
         vec3 o;
         vec3 d;
         c.instance_ray(rec, ray.origin, ray.dir, o, d);
-        if (trace_bvh(c, rec.root, o, d, ray.tmin, rec.instance, q, use_ls, hit, prim)) return true;
+        if (trace_bvh(c, rec.root, o, d, ray.tmin, ray.tmax, rec.instance, q, use_ls, hit, prim)) return true;
       }
       return false;
     };
     const lsk::BvhNode& root = c.top_nodes[0];
     if (root.count > 0)
       instances(root.first, root.count);
-    else if (q != Query::AnyHit && !use_ls && order_free_ray(ray.origin, ray.dir, ray.tmin))  // no decision depends on the order
+    else
       [&]() __attribute__((noinline)) {  // its own function, with the instances' walks inlined in it (fewer spills)
         walk_exact(top_exact_, top_exact_.entry_of[0],
                    make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir, true), ray.tmin, hit, instances,
-                   [](uint) {});
+                   [](uint, uint) {});
       }();
-    else
-      walk(top_, top_.wide_of[0],
-           make_slab_ray<FloatBatch, WideNode<K>>(ray.origin, inv_dir, order_free_ray(ray.origin, ray.dir, ray.tmin)),
-           ray.tmin, hit,
-           [&](uint, bool leaf, uint first, uint count, uint, uint) {
-             if (!leaf) return Visit::Descend;
-             return instances(first, count) ? Visit::Stop : Visit::Skip;
-           });
     return lsk::finish_hit(hit);
   }
 
@@ -654,24 +506,19 @@ class WideTracer final : public FastTracer {
   }
 
   bool two_level_;
-  bool ordered_;  // a Line Space structure: treelets for the reference's order
-  std::shared_ptr<const ObjectPart<K, W>> part_;
+  bool line_space_;
+  std::shared_ptr<const ObjectPart<W>> part_;
   const TriBlock* blocks_ = nullptr;  // part_->blocks.blocks.data(): one load less on the hot path
-  WideTree<K> top_;
   ExactWideTree<W> top_exact_;
 };
 
 }  // namespace
 
-std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int width, int exact_width) {
-  if (width != 4 && width != 8) throw InputError("wide BVH width must be 4 or 8, not " + std::to_string(width));
+std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int exact_width) {
   if (exact_width != 4 && exact_width != 8)
     throw InputError("exact wide BVH width must be 4 or 8, not " + std::to_string(exact_width));
-  if (width == 8)
-    return exact_width == 8 ? std::shared_ptr<const FastTracer>(std::make_shared<WideTracer<3, 8>>(accel))
-                            : std::make_shared<WideTracer<3, 4>>(accel);
-  return exact_width == 8 ? std::shared_ptr<const FastTracer>(std::make_shared<WideTracer<2, 8>>(accel))
-                          : std::make_shared<WideTracer<2, 4>>(accel);
+  if (exact_width == 8) return std::make_shared<WideTracer<8>>(accel);
+  return std::make_shared<WideTracer<4>>(accel);
 }
 
 }  // namespace ls

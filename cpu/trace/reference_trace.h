@@ -12,6 +12,6 @@ namespace ls {
 // instantiated there took GCC's inlining budget from the fast walks (5 % more instructions a ray).
 lsk::Hit trace_ray_reference(lsk::TraceContext& context, const lsk::Ray& ray, bool two_level, bool any_hit);
 bool trace_bvh_reference(lsk::TraceContext& context, uint32_t root, const lsk::vec3& origin, const lsk::vec3& dir,
-                         float tmin, uint32_t instance, bool any_hit, bool use_ls, lsk::Hit& hit, uint32_t& hit_prim);
+                         float tmin, float tmax, uint32_t instance, bool any_hit, bool use_ls, lsk::Hit& hit, uint32_t& hit_prim);
 
 }  // namespace ls

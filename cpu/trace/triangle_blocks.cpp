@@ -29,7 +29,7 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
     std::array<int, W> order;
     int leaves = 0;
     for (int l = 0; l < W; ++l)
-      if (node.count[l] > 0) order[size_t(leaves++)] = l;
+      if (primitive_lane(node.count[l])) order[size_t(leaves++)] = l;
     std::stable_sort(order.begin(), order.begin() + leaves, [&](int a, int b) { return node.count[a] > node.count[b]; });
     std::array<size_t, W> opened_block{};  // the blocks opened for this node's short leaves
     std::array<uint32_t, W> used{};        // and the lanes taken in each
@@ -56,7 +56,7 @@ TriangleBlocks build_triangle_blocks(const std::vector<lsk::BvhNode>& nodes, con
       place(range, lane);
     }
   }
-  for (const lsk::BvhNode& n : nodes)  // the binary leaves outside them (the treelets')
+  for (const lsk::BvhNode& n : nodes)  // the binary leaves outside them (Line Space nodes' own)
     if (n.count > 0 && lane_of_tri[n.first] == lsk::LS_INVALID) {
       place(Range{n.first, n.count}, lanes);
       lanes += (n.count + 3u) / 4u * 4u;

@@ -28,6 +28,7 @@ layout(std430, binding = 10) buffer Rays { Ray rays[]; };
 layout(std430, binding = 11) buffer Hits { Hit hits[]; };
 layout(push_constant) uniform P { uint ls_enabled; uint ls_n; float ls_cos2; uint two_level; uint ls_reverse; } pc;
 uint ls_enabled = pc.ls_enabled; float ls_cos2 = pc.ls_cos2; uint ls_reverse = pc.ls_reverse;
+const uint walk_far_first = 0u;
 LsCounters ls_counters;
 void count_work(uint node, uint boxes, uint triangles) {}
 #include "kernels/ls_lookup.h"
