@@ -1,21 +1,27 @@
-#include "cpu/trace/fast_tracer.h"
+// The fast path's tracer (fast_tracer.h) as a template over the tree's width and the structure's
+// kind, included by the two translation units that instantiate it: exact_tracer.cpp (with
+// make_fast_tracer) and line_space_tracer.cpp.  Internal to cpu/trace.
+#pragma once
 
 #include "common/structure/accel.h"
 #include "cpu/trace/exact_wide_bvh.h"
-#include "cpu/trace/simd.h"
+#include "cpu/trace/fast_tracer.h"
 #include "cpu/trace/reference_trace.h"
+#include "cpu/trace/simd.h"
 #include "cpu/trace/triangle_blocks.h"
 
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <type_traits>
 
 namespace ls {
+namespace wide_tracer {
 
 // The batch the box tests run in: 8 floats with AVX (LINESPACE_ISA=avx2 or native), else 4 (SSE2,
 // the portable x86-64 default; NEON on aarch64).  AVX-512's 16 floats would be wider than an 8-wide
-// node or a 4-wide treelet's 6 boxes, so 8 is the most taken.
+// node, so 8 is the most taken.
 #if XSIMD_WITH_AVX
 using SimdArch = xsimd::avx;
 #else
@@ -23,19 +29,13 @@ using SimdArch = Simd4Arch;
 #endif
 using FloatBatch = xsimd::batch<float, SimdArch>;
 
-std::string fast_path_isa() {
-  return std::string(SimdArch::name()) + " (" + std::to_string(FloatBatch::size) + " floats)";
-}
-
-namespace {
-
 using lsk::Hit;
 using lsk::LS_INVALID;
 using lsk::uint;
 using lsk::vec3;
 
 // Rays the order-free walk takes: finite origin, direction and tmin (its slab arithmetic is the
-// reference's only there; anything else follows the reference's order in the treelets).
+// reference's only there; anything else takes the reference kernel).
 LS_ALWAYS_INLINE bool order_free_ray(const vec3& origin, const vec3& dir, float tmin) {
   return std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z) && std::isfinite(dir.x) &&
          std::isfinite(dir.y) && std::isfinite(dir.z) && !std::isnan(tmin);
@@ -93,7 +93,7 @@ template <bool kBySign, bool kParallel, class Batch>
 LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
                                  Batch& widened) {
   constexpr float big = 3.0e38f;
-  auto row = [&](uint32_t offset) { return Batch::load_aligned(reinterpret_cast<const float*>(rows + offset)); };
+  auto row = [&](uint32_t offset) LS_ALWAYS_LAMBDA { return Batch::load_aligned(reinterpret_cast<const float*>(rows + offset)); };
   Batch tn[3];
   Batch tf[3];
   for (int a = 0; a < 3; ++a) {
@@ -206,7 +206,7 @@ struct ExactWalk {
       count = node.count[near];
       return true;
     }
-    auto push = [&](unsigned l) {
+    auto push = [&](unsigned l) LS_ALWAYS_LAMBDA {
       stack[sp++] = Pending{node.child[l], node.count[l], tn[l]};
       if (node.count[l] == 0u) {
         const char* p = reinterpret_cast<const char*>(&tree.nodes[node.child[l]]);
@@ -265,16 +265,19 @@ struct ObjectPart {
   ExactWideTree<W> exact;
 };
 
-// W: the wide trees' width (4 or 8).
-template <int W>
+// W: the wide trees' width (4 or 8); kLs: a Line Space structure (its wide trees have Line Space
+// lanes).  The two kinds are instantiated in two translation units (exact_tracer.cpp and
+// line_space_tracer.cpp): in one, the Line Space walk's code took GCC's inlining budget from the
+// exact walk (bvh on fireplace 1,602 -> 1,854 instructions a ray).
+template <int W, bool kLs>
 class WideTracer final : public FastTracer {
  public:
   // Every query but the reference's any hit (trace --any-hit: the triangle it reports is the first
   // in the reference's order), which the reference kernels answer, walks the wide trees order-free;
   // shadow rays are occlusion queries (occluded()).
-  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()), line_space_(accel.spec.line_space()) {
+  WideTracer(const Accel& accel) : two_level_(accel.spec.two_level()) {
     const std::vector<uint32_t> none;
-    const std::vector<uint32_t>& node_ls = line_space_ ? accel.node_ls : none;
+    const std::vector<uint32_t>& node_ls = kLs ? accel.node_ls : none;
     auto part = std::make_shared<ObjectPart<W>>();
     const std::vector<uint32_t> roots = two_level_ ? accel.object_roots : std::vector<uint32_t>{0u};
     part->exact = build_exact_wide_tree<W>(accel.nodes, node_ls, roots);
@@ -286,7 +289,7 @@ class WideTracer final : public FastTracer {
 
   // The object part of `other`, a new wide top tree over accel.top_nodes.
   WideTracer(const WideTracer& other, const Accel& accel)
-      : two_level_(other.two_level_), line_space_(other.line_space_), part_(other.part_), blocks_(other.blocks_) {
+      : two_level_(other.two_level_), part_(other.part_), blocks_(other.blocks_) {
     build_top(accel);
   }
 
@@ -386,23 +389,23 @@ class WideTracer final : public FastTracer {
     bool use_ls;
     ExactBoxRay<W> exact_ray;
     LazyBlockRay tri_ray;
-    ObjectQuery(const vec3& o, const vec3& d, const vec3& inv, float t0, float t1, uint inst, bool any, bool ls)
+    LS_ALWAYS_INLINE ObjectQuery(const vec3& o, const vec3& d, const vec3& inv, float t0, float t1, uint inst, bool any, bool ls)
         : origin(o), dir(d), inv_dir(inv), tmin(t0), tmax(t1), instance(inst), any_hit(any), use_ls(ls), tri_ray(o, d) {
       init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, o, inv, true);
     }
   };
 
-  // The order-free walk below `entry`, leaves tested against tri_ray(), Line Space lanes (kLs: a
-  // Line Space structure) answered by ls_node.  True: an occlusion query's hit (any_hit is one
-  // here: the reference's any hit never walks order-free).
-  template <bool kLs>
+  // The order-free walk below `entry`, leaves tested against tri_ray(), Line Space lanes answered
+  // by ls_node.  True: an occlusion query's hit (any_hit is one here: the reference's any hit never
+  // walks order-free).
   LS_ALWAYS_INLINE bool run_exact(lsk::TraceContext& c, uint entry, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
     bool stopped = false;
     auto run = [&](auto&& ray_for_leaf) LS_ALWAYS_LAMBDA {
       walk_exact(
           part_->exact, entry, q.exact_ray, q.tmin, hit,
           [&](uint child, uint n) {
-            if (kLs && n == kLsLane) return stopped = ls_node(c, child, q, hit, hit_prim);
+            if constexpr (kLs)
+              if (n == kLsLane) return stopped = ls_node(c, child, q, hit, hit_prim);
             return stopped = trace_blocks(c, blocks_, child, n, ray_for_leaf(), q.tmin, q.instance, q.any_hit, hit, hit_prim);
           },
           [&](uint child, uint n) {
@@ -433,7 +436,7 @@ class WideTracer final : public FastTracer {
     if (node.count > 0)
       return trace_blocks(c, blocks_, part_->blocks.lane_of[b], node.count, q.tri_ray(), q.tmin, q.instance, q.any_hit, hit,
                           hit_prim);
-    return run_exact<true>(c, part_->exact.entry_of[b], q, hit, hit_prim);
+    return run_exact(c, part_->exact.entry_of[b], q, hit, hit_prim);
   }
 
   // lsk::TraceContext::trace_bvh on the wide trees: the order-free walk, except for the reference's
@@ -453,11 +456,9 @@ class WideTracer final : public FastTracer {
     const vec3 inv_dir = lsk::safe_reciprocal(dir);
     ObjectQuery query(origin, dir, inv_dir, tmin, tmax, instance, any_hit, use_ls);
     const uint root_entry = part_->exact.entry_of[root];
-    const bool root_ls = line_space_ && c.node_ls[root] != LS_INVALID;
+    const bool root_ls = kLs && c.node_ls[root] != LS_INVALID;
     // The entry's node tests the root's children, which pass only where the root's box would.
-    if (root_entry != LS_INVALID && !root_ls)
-      return line_space_ ? run_exact<true>(c, root_entry, query, hit, hit_prim)
-                         : run_exact<false>(c, root_entry, query, hit, hit_prim);
+    if (root_entry != LS_INVALID && !root_ls) return run_exact(c, root_entry, query, hit, hit_prim);
     float t_root;
     if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
     return ls_node(c, root, query, hit, hit_prim);  // a Line Space at the root, or a root that is a leaf
@@ -506,19 +507,15 @@ class WideTracer final : public FastTracer {
   }
 
   bool two_level_;
-  bool line_space_;
   std::shared_ptr<const ObjectPart<W>> part_;
   const TriBlock* blocks_ = nullptr;  // part_->blocks.blocks.data(): one load less on the hot path
   ExactWideTree<W> top_exact_;
 };
 
-}  // namespace
+}  // namespace wide_tracer
 
-std::shared_ptr<const FastTracer> make_fast_tracer(const Accel& accel, int exact_width) {
-  if (exact_width != 4 && exact_width != 8)
-    throw InputError("exact wide BVH width must be 4 or 8, not " + std::to_string(exact_width));
-  if (exact_width == 8) return std::make_shared<WideTracer<8>>(accel);
-  return std::make_shared<WideTracer<4>>(accel);
-}
+// The tracer of the Line Space structures (line_space_tracer.cpp); exact_width 4 or 8, checked by
+// make_fast_tracer (exact_tracer.cpp).
+std::shared_ptr<const FastTracer> make_line_space_tracer(const Accel& accel, int exact_width);
 
 }  // namespace ls
