@@ -177,7 +177,7 @@ struct Collapser {
     const int n = children(b, lanes);
     ExactWideNode<kWidth>& w = tree.nodes[index];
     std::memset(&w, 0, sizeof(w));
-    for (int i = 0; i < kWidth; ++i) {  // unused lanes: a NaN box, which no ray enters (fast_tracer.cpp)
+    for (int i = 0; i < kWidth; ++i) {  // unused lanes: a NaN box, which no ray enters (wide_tracer.h)
       w.child[i] = lsk::LS_INVALID;
       for (int a = 0; a < 3; ++a) w.lo[a][i] = w.hi[a][i] = std::numeric_limits<float>::quiet_NaN();
     }

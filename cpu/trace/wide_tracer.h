@@ -459,9 +459,13 @@ class WideTracer final : public FastTracer {
     const bool root_ls = kLs && c.node_ls[root] != LS_INVALID;
     // The entry's node tests the root's children, which pass only where the root's box would.
     if (root_entry != LS_INVALID && !root_ls) return run_exact(c, root_entry, query, hit, hit_prim);
+    const lsk::BvhNode& node = c.nodes[root];
     float t_root;
-    if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, c.nodes[root].lo, c.nodes[root].hi, t_root)) return false;
-    return ls_node(c, root, query, hit, hit_prim);  // a Line Space at the root, or a root that is a leaf
+    if (!lsk::ray_box(origin, inv_dir, tmin, hit.t, node.lo, node.hi, t_root)) return false;
+    if (!root_ls)  // a root that is a leaf (many small objects of a two-level structure)
+      return trace_blocks(c, blocks_, part_->blocks.lane_of[root], node.count, query.tri_ray(), tmin, instance, any_hit, hit,
+                          hit_prim);
+    return ls_node(c, root, query, hit, hit_prim);  // a Line Space at the root
   }
 
   Hit trace_flat(lsk::TraceContext& c, const lsk::Ray& ray, Query q) const {
