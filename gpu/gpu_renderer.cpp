@@ -167,7 +167,7 @@ RenderResult render_gpu(const VulkanContext& context, const Scene& scene, const 
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces, like the CPU renderer
     ShadePush push{};
-    push.sample_index = uint32_t(s);
+    push.sample_index = options.first_sample + uint32_t(s);
     push.mode = 0;
     push.count = uint32_t(order.size());
     run_shade(push, selection, extension.hits, extension, shadow);  // the selected pixels' camera rays into extension's list

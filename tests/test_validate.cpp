@@ -6,6 +6,7 @@
 #include "common/structure/accel.h"
 #include "cpu/app/cpu_backend.h"
 #include "scenes/load_scene.h"
+#include "validate/bias_estimate.h"
 #include "validate/heatmap.h"
 #include "validate/policy_study.h"
 #include "validate/rmse_study.h"
@@ -14,6 +15,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -32,6 +34,31 @@ ImageSettings tiny_image() {
 
 void quiet(const std::string&) {}
 
+// A render of options.spp samples as the studies make it, rendered here directly: half A the first
+// ceil(spp / 2) sample indices, half B the rest, and both averaged with their sample counts.
+struct Halves {
+  RenderResult a, b;
+  int n_a = 0, n_b = 0;
+  std::vector<glm::vec3> total() const {
+    std::vector<glm::vec3> out;
+    const double wa = double(n_a) / double(n_a + n_b), wb = 1.0 - wa;
+    for (size_t i = 0; i < a.total.size(); ++i) out.push_back(glm::vec3(wa * glm::dvec3(a.total[i]) + wb * glm::dvec3(b.total[i])));
+    return out;
+  }
+};
+
+Halves render_halves(StudyRenderer& renderer, RenderOptions o) {
+  Halves h;
+  h.n_a = o.spp - o.spp / 2;
+  h.n_b = o.spp / 2;
+  o.spp = h.n_a;
+  h.a = renderer.render(o);
+  o.first_sample = uint32_t(h.n_a);
+  o.spp = h.n_b;
+  h.b = renderer.render(o);
+  return h;
+}
+
 }  // namespace
 
 TEST_CASE("refusal angle 0: every Line Space gives RMSE 0 on every bounce", "[validate]") {
@@ -48,6 +75,10 @@ TEST_CASE("refusal angle 0: every Line Space gives RMSE 0 on every bounce", "[va
     INFO(r.structure << " from bounce " << r.start_bounce);
     REQUIRE(r.refused.empty());
     REQUIRE(r.rmse == 0.0);
+    // The same random numbers make equal images in each half: no noise, no bias, nothing uncertain.
+    REQUIRE(r.bias.rmse_bias == 0.0);
+    REQUIRE(r.bias.rmse_bias_stderr == 0.0);
+    REQUIRE(r.bias.noise_floor == 0.0);
     REQUIRE(r.contribution_rmse.size() == 4);
     for (double c : r.contribution_rmse) REQUIRE(c == 0.0);
   }
@@ -59,7 +90,7 @@ TEST_CASE("switching to the Line Space at bounce k leaves the bounces before k b
   options.ls.min_triangles = 0;
   StudyRenderer renderer(make_cpu_backend(), scene, options);
   const ImageSettings settings = tiny_image();
-  const Reference reference = render_reference(renderer, settings);
+  Reference reference = render_reference(renderer, settings);
   const StructureSpec ls = parse_structure("f-ls:8:6");
   for (int k = 1; k <= settings.bounces; ++k) {
     INFO("start bounce " << k);
@@ -78,12 +109,17 @@ TEST_CASE("the rmse study's figures equal a direct computation from the two rend
   const ImageSettings settings = tiny_image();
   const RmseStudy study =
       run_rmse_study(renderer, "generated", parse_structure_list("2l-ls:2:4"), settings, "", 0.1f, quiet);
-  const Reference reference = render_reference(renderer, settings);
-  const RenderResult direct = renderer.render(settings.options(schedule_from(parse_structure("2l-ls:2:4"), 2)));
+  const Halves reference = render_halves(renderer, settings.options(parse_schedule("bvh")));
+  const Halves direct = render_halves(renderer, settings.options(schedule_from(parse_structure("2l-ls:2:4"), 2)));
   const RmseRow* row = study.find("2l-ls:2:4", 2);
   REQUIRE(row);
-  const float e = exposure_scale(reference.result.total);
-  REQUIRE(row->rmse == rmse(reference.result.total, direct.total, e));
+  const float e = exposure_scale(reference.total());
+  REQUIRE(row->rmse == Approx(rmse(reference.total(), direct.total(), e)).epsilon(1e-9));
+  REQUIRE(row->spp == settings.spp);
+  const BiasEstimate bias = estimate_bias(reference.a.total, direct.a.total, reference.b.total, direct.b.total, e,
+                                          direct.n_a, direct.n_b);
+  REQUIRE(row->bias.rmse_bias == bias.rmse_bias);
+  REQUIRE(row->bias.rmse_bias_stderr == bias.rmse_bias_stderr);
   REQUIRE(row->bytes == renderer.structure(parse_structure("2l-ls:2:4")).bytes_total());
   // The Markdown summary has the reference line and one line per structure.
   REQUIRE(study.summary().rows.size() == 2);
@@ -113,7 +149,8 @@ TEST_CASE("the Pareto front is exactly the points no other point dominates", "[v
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<SweepPoint> points(40);
   for (SweepPoint& p : points) {
-    p.rmse = std::round(u(rng) * 20.0) / 20.0;  // ties on purpose
+    p.bias.rmse_bias = std::round(u(rng) * 20.0) / 20.0;  // ties on purpose
+    p.rmse = 1.0 - p.bias.rmse_bias;                      // the front is drawn on rmse_bias, not on the RMSE
     p.mrays_per_s = std::round(u(rng) * 20.0) / 20.0;
   }
   points[5].refused = "over budget";
@@ -122,12 +159,14 @@ TEST_CASE("the Pareto front is exactly the points no other point dominates", "[v
   int front = 0;
   for (size_t i = 0; i < points.size(); ++i) {
     bool dominated = !points[i].refused.empty();
-    if (reference >= points[i].mrays_per_s && (reference > points[i].mrays_per_s || points[i].rmse > 0.0)) dominated = true;
-    for (size_t j = 0; j < points.size(); ++j)
-      if (j != i && points[j].refused.empty() && points[j].rmse <= points[i].rmse &&
-          points[j].mrays_per_s >= points[i].mrays_per_s &&
-          (points[j].rmse < points[i].rmse || points[j].mrays_per_s > points[i].mrays_per_s))
+    const double ei = points[i].bias.rmse_bias;
+    if (reference >= points[i].mrays_per_s && (reference > points[i].mrays_per_s || ei > 0.0)) dominated = true;
+    for (size_t j = 0; j < points.size(); ++j) {
+      const double ej = points[j].bias.rmse_bias;
+      if (j != i && points[j].refused.empty() && ej <= ei && points[j].mrays_per_s >= points[i].mrays_per_s &&
+          (ej < ei || points[j].mrays_per_s > points[i].mrays_per_s))
         dominated = true;
+    }
     REQUIRE(points[i].pareto == !dominated);
     front += points[i].pareto;
   }
@@ -170,8 +209,8 @@ TEST_CASE("the policy study's RMSE and rays on X equal a direct computation from
   const StructureSpec x = parse_structure("f-ls:3:6");
   const PolicyStudy study = run_policy_study(renderer, "builtin:cornell", x, {1, 3}, {0.3f, 0.6f}, settings, quiet);
   REQUIRE(study.points.size() == 4);
-  const RenderResult reference = renderer.render(settings.options(parse_schedule("bvh")));
-  const float e = exposure_scale(reference.total);
+  const Halves reference_halves = render_halves(renderer, settings.options(parse_schedule("bvh")));
+  const float e_halves = exposure_scale(reference_halves.total());
   auto indirect = [](const RenderResult& r, int from) {
     uint64_t n = 0;
     for (size_t k = size_t(from); k < r.bounces.size(); ++k) n += r.bounces[k].extension_rays + r.bounces[k].shadow_rays;
@@ -182,8 +221,11 @@ TEST_CASE("the policy study's RMSE and rays on X equal a direct computation from
     RenderOptions o = settings.options(p.policy == "bounce" ? schedule_from(x, p.start_bounce) : parse_schedule("bvh"));
     if (p.policy == "throughput") o.throughput_switch = ThroughputSwitch{p.threshold, x};
     const RenderResult r = renderer.render(o);
-    REQUIRE(p.rmse == rmse(reference.total, r.total, e));
+    const Halves h = render_halves(renderer, o);
+    REQUIRE(p.rmse == Approx(rmse(reference_halves.total(), h.total(), e_halves)).epsilon(1e-9));
     REQUIRE(p.rmse > 0.0);
+    REQUIRE(p.bias.rmse_bias == estimate_bias(reference_halves.a.total, h.a.total, reference_halves.b.total, h.b.total,
+                                              e_halves, h.n_a, h.n_b).rmse_bias);
     REQUIRE(p.indirect_rays == indirect(r, 1));
     if (p.policy == "bounce") {
       REQUIRE(p.rays_on_x == indirect(r, p.start_bounce));  // every ray from the start bounce on
@@ -209,5 +251,89 @@ TEST_CASE("the policy study's RMSE and rays on X equal a direct computation from
     INFO("from bounce " << c.start_bounce << " at " << c.fraction_on_x);
     if (std::isnan(expected)) REQUIRE(std::isnan(c.throughput_rmse_at_fraction));
     else REQUIRE(c.throughput_rmse_at_fraction == Approx(expected));
+  }
+}
+
+TEST_CASE("the two halves are the plain render's samples, split: first_sample 0 changes nothing", "[validate]") {
+  const Scene scene = load_scene("builtin:cornell");
+  StudyRenderer renderer(make_cpu_backend(), scene, AccelOptions{});
+  RenderOptions o = tiny_image().options(parse_schedule("bvh"));
+  o.spp = 5;
+  const RenderResult plain = renderer.render(o);
+  RenderOptions explicit_zero = o;
+  explicit_zero.first_sample = 0;
+  REQUIRE(renderer.render(explicit_zero).total == plain.total);
+  const Halves h = render_halves(renderer, o);
+  REQUIRE(h.n_a == 3);
+  REQUIRE(h.n_b == 2);
+  REQUIRE(h.a.total != h.b.total);  // other sample indices, other random numbers
+  const std::vector<glm::vec3> combined = h.total();
+  for (size_t i = 0; i < plain.total.size(); ++i)
+    for (int c = 0; c < 3; ++c) REQUIRE(combined[i][c] == Approx(plain.total[i][c]).epsilon(1e-5).margin(1e-6));
+  // What the studies render is exactly that.
+  const SplitRender split = render_split(renderer, o);
+  REQUIRE(split.spp == std::array<int, 2>{3, 2});
+  REQUIRE(split.half[0].total == h.a.total);
+  REQUIRE(split.half[1].total == h.b.total);
+  REQUIRE(split.combined.bounces[1].extension_rays == plain.bounces[1].extension_rays);
+}
+
+TEST_CASE("rmse_bias of a real Line Space stays put from 4 to 16 spp while the RMSE falls", "[validate]") {
+  const Scene scene = load_scene("builtin:cornell");
+  AccelOptions options;
+  options.ls.min_triangles = 0;
+  StudyRenderer renderer(make_cpu_backend(), scene, options);
+  ImageSettings settings = tiny_image();
+  settings.width = settings.height = 48;
+  std::vector<RmseRow> rows;
+  for (int spp : {4, 16}) {
+    settings.spp = spp;
+    rows.push_back(*run_rmse_study(renderer, "builtin:cornell", parse_structure_list("f-ls:4:2"), settings, "", 0.1f, quiet)
+                        .find("f-ls:4:2", 1));
+  }
+  const BiasEstimate &b4 = rows[0].bias, &b16 = rows[1].bias;
+  INFO("4 spp: RMSE " << rows[0].rmse << ", rmse_bias " << b4.rmse_bias << " ± " << b4.rmse_bias_stderr);
+  INFO("16 spp: RMSE " << rows[1].rmse << ", rmse_bias " << b16.rmse_bias << " ± " << b16.rmse_bias_stderr);
+  REQUIRE(b16.rmse_bias > 3.0 * b16.rmse_bias_stderr);  // a real bias, seen
+  REQUIRE(std::abs(b4.rmse_bias - b16.rmse_bias) <=
+          3.0 * std::sqrt(b4.rmse_bias_stderr * b4.rmse_bias_stderr + b16.rmse_bias_stderr * b16.rmse_bias_stderr));
+  REQUIRE(rows[0].rmse > rows[1].rmse);
+}
+
+TEST_CASE("spp auto: each configuration doubles its samples until rmse_bias is known, or the time is up", "[validate]") {
+  const Scene scene = load_scene("builtin:cornell");
+  AccelOptions options;
+  options.ls.min_triangles = 0;
+  StudyRenderer renderer(make_cpu_backend(), scene, options);
+  ImageSettings settings = tiny_image();
+  settings.spp = 4;
+  settings.auto_spp.enabled = true;
+  settings.auto_spp.rel_stderr = 0.3;
+  settings.auto_spp.seconds = 60.0;
+  settings.auto_spp.max_spp = 256;
+  const RmseStudy study = run_rmse_study(renderer, "builtin:cornell", parse_structure_list("f-ls:4:2"), settings, "", 0.1f, quiet);
+  for (const RmseRow& r : study.rows) {
+    INFO("from bounce " << r.start_bounce << ": " << r.spp << " spp, " << r.spp_stop << ", rmse_bias " << r.bias.rmse_bias
+                        << " ± " << r.bias.rmse_bias_stderr);
+    REQUIRE((r.spp == 4 || r.spp == 8 || r.spp == 16 || r.spp == 32 || r.spp == 64 || r.spp == 128 || r.spp == 256));
+    if (r.spp_stop == "converged") REQUIRE(r.bias.rmse_bias_stderr <= 0.3 * r.bias.rmse_bias);
+    else REQUIRE((r.spp_stop == "max spp" || r.spp_stop == "time budget"));
+    if (r.spp_stop == "max spp") REQUIRE(r.spp == 256);
+  }
+  REQUIRE(study.json()["spp_auto"]["rel_stderr"] == 0.3);
+  // An exact approximation converges at once: its rmse_bias is 0 with no uncertainty.
+  settings.lookup.angle_degrees = 0.0f;
+  settings.auto_spp.seconds = 1e6;
+  for (const RmseRow& r : run_rmse_study(renderer, "builtin:cornell", parse_structure_list("f-ls:4:2"), settings, "", 0.1f, quiet).rows) {
+    REQUIRE(r.spp == 4);
+    REQUIRE(r.spp_stop == "converged");
+  }
+  // A budget too short for any doubling stops at the start.
+  settings.lookup.angle_degrees = 45.0f;
+  settings.auto_spp.seconds = 1e-9;
+  settings.auto_spp.rel_stderr = 1e-6;
+  for (const RmseRow& r : run_rmse_study(renderer, "builtin:cornell", parse_structure_list("f-ls:4:2"), settings, "", 0.1f, quiet).rows) {
+    REQUIRE(r.spp == 4);
+    REQUIRE(r.spp_stop == "time budget");
   }
 }

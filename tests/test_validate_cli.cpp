@@ -63,6 +63,68 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
   REQUIRE(validate("").status == 2);
 }
 
+TEST_CASE("linespace-validate: bad --spp, --auto-rel-stderr and --auto-seconds exit 2 with a one-line reason", "[cli]") {
+  for (const std::string& c : {"rmse --spp 0", "rmse --spp 65537", "rmse --spp 4x", "rmse --spp automatic", "rmse --spp ''",
+                               "sweep --spp auto --auto-rel-stderr 0", "sweep --spp auto --auto-rel-stderr 1",
+                               "paper --spp auto --auto-rel-stderr -0.1", "budget --spp auto --auto-rel-stderr nan",
+                               "policy --spp auto --auto-seconds 0", "rmse --spp auto --auto-seconds -5",
+                               "rmse --spp 8 --auto-seconds 30", "rmse --auto-rel-stderr 0.2",
+                               "bound --spp auto", "hits --spp auto", "candidates --spp auto"}) {
+    INFO(c);
+    const Run r = validate(c + " --out " + temp("unused").string());
+    REQUIRE(r.status == 2);
+    REQUIRE(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    REQUIRE(r.err.rfind("linespace-validate: ", 0) == 0);
+  }
+  REQUIRE_FALSE(fs::exists(temp("unused") / "rmse.json"));
+}
+
+TEST_CASE("linespace-validate rmse.json rows carry rmse_bias and its standard error; --spp auto says why it stopped", "[cli]") {
+  const fs::path out = temp("rmse_bias");
+  const std::string common = " --scene builtin:cornell --structures f-ls:3:4 --size 16x16 --bounces 2 --ls-min-triangles 0 --out ";
+  Run r = validate("rmse --spp 4" + common + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  nlohmann::json j = nlohmann::json::parse(slurp(out / "rmse.json"));
+  REQUIRE(j["rows"].size() == 2);
+  REQUIRE(j["spp_auto"].is_null());
+  for (const auto& row : j["rows"]) {
+    for (const char* key : {"rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor"}) REQUIRE(row[key].is_number());
+    REQUIRE(row["rmse_bias"].get<double>() >= 0.0);
+    REQUIRE(row["rmse_bias_stderr"].get<double>() >= 0.0);
+    REQUIRE(row["spp"] == 4);
+    REQUIRE_FALSE(row.contains("spp_stop"));
+  }
+  const std::string md = slurp(out / "rmse.md"), csv = slurp(out / "rmse.csv");
+  REQUIRE(md.find("rmse_bias from bounce 1") != std::string::npos);
+  REQUIRE(md.find("noise floor") != std::string::npos);
+  REQUIRE(csv.find("rmse,rmse_bias,rmse_bias_stderr,noise_floor,spp,spp_stop") != std::string::npos);
+
+  // 1 sample per pixel has no second half: the keys are there, null.
+  r = validate("rmse --spp 1" + common + out.string());
+  REQUIRE(r.status == 0);
+  j = nlohmann::json::parse(slurp(out / "rmse.json"));
+  for (const auto& row : j["rows"]) {
+    REQUIRE(row["rmse_bias"].is_null());
+    REQUIRE(row["rmse_bias_stderr"].is_null());
+  }
+
+  r = validate("rmse --spp auto --auto-rel-stderr 0.5 --auto-seconds 20" + common + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  j = nlohmann::json::parse(slurp(out / "rmse.json"));
+  REQUIRE(j["spp_auto"]["rel_stderr"] == 0.5);
+  REQUIRE(j["spp_auto"]["seconds"] == 20.0);
+  for (const auto& row : j["rows"]) {
+    const std::string stop = row["spp_stop"];
+    REQUIRE((stop == "converged" || stop == "time budget" || stop == "max spp"));
+    REQUIRE(row["spp"].get<int>() >= 4);
+    REQUIRE(r.err.find(stop) != std::string::npos);  // said on stderr too
+    if (stop == "converged") REQUIRE(row["rmse_bias_stderr"].get<double>() <= 0.5 * row["rmse_bias"].get<double>());
+  }
+  REQUIRE(slurp(out / "rmse.md").find("--spp auto stopped") != std::string::npos);
+}
+
 TEST_CASE("linespace-validate bound and hits refuse rays over --max-memory before building anything", "[cli]") {
   // 200,000 rays made here: up to 65 B a ray for bound (the generator's peak), 72 B for hits (the
   // rays and two hit arrays): 13 and 14.4 MB, over 8 MB.  Refused before a Vulkan device is asked.
@@ -91,7 +153,8 @@ TEST_CASE("linespace-validate rmse writes rmse.json with the documented keys and
   const nlohmann::json j = nlohmann::json::parse(slurp(out / "rmse.json"));
   REQUIRE(j["rows"].size() == 4);
   for (const auto& row : j["rows"]) {
-    for (const char* key : {"structure", "start_bounce", "rmse", "mrays_per_s", "bytes"}) REQUIRE(row.contains(key));
+    for (const char* key : {"structure", "start_bounce", "rmse", "rmse_bias", "rmse_bias_stderr", "mrays_per_s", "bytes"})
+      REQUIRE(row.contains(key));
     REQUIRE(row["contribution_rmse"].size() == 3);
     // Bounces before the switch are exact.
     for (int b = 0; b < row["start_bounce"].get<int>(); ++b) REQUIRE(row["contribution_rmse"][size_t(b)] == 0.0);

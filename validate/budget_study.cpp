@@ -15,7 +15,7 @@ std::string dn(const ObjectLs& o) { return o.n > 0 ? std::to_string(o.depth) + "
 
 // Builds `spec` and measures it from every start bounce.
 BudgetSide measure_side(StudyRenderer& renderer, const StructureSpec& spec, const ImageSettings& settings,
-                        const Reference& reference, const Log& log) {
+                        Reference& reference, const Log& log) {
   BudgetSide side;
   side.structure = spec.name();
   const Accel& accel = renderer.structure(spec);
@@ -24,16 +24,30 @@ BudgetSide measure_side(StudyRenderer& renderer, const StructureSpec& spec, cons
   for (int k = 1; k <= settings.bounces; ++k) {
     const Measured m = measure(renderer, schedule_from(spec, k), settings, reference);
     side.rmse.push_back(m.rmse);
+    side.bias.push_back(m.bias);
+    side.spp.push_back(m.spp);
+    side.spp_stop.push_back(m.spp_stop);
     if (k == 1) side.mrays_per_s = m.mrays_per_s;
-    log("  " + side.structure + " from bounce " + std::to_string(k) + ": RMSE " + rmse_text(m.rmse) + ", " +
-        fixed(m.mrays_per_s, 2) + " MRays/s");
+    log("  " + side.structure + " from bounce " + std::to_string(k) + ": RMSE " + rmse_text(m.rmse) + ", rmse_bias " +
+        bias_text(m.bias) + " (" + spp_text(m) + "), " + fixed(m.mrays_per_s, 2) + " MRays/s");
   }
   return side;
 }
 
 nlohmann::json side_json(const BudgetSide& s, double reference_mrays_per_s) {
+  nlohmann::json bias = nlohmann::json::array(), stderr_ = nlohmann::json::array(), floor = nlohmann::json::array();
+  for (const BiasEstimate& b : s.bias) {
+    bias.push_back(number_or_null(b.rmse_bias));
+    stderr_.push_back(number_or_null(b.rmse_bias_stderr));
+    floor.push_back(number_or_null(b.noise_floor));
+  }
   return {{"structure", s.structure},
           {"rmse_from_bounce", s.rmse},
+          {"rmse_bias_from_bounce", bias},
+          {"rmse_bias_stderr_from_bounce", stderr_},
+          {"noise_floor_from_bounce", floor},
+          {"spp_from_bounce", s.spp},
+          {"spp_stop_from_bounce", s.spp_stop},
           {"mrays_per_s", s.mrays_per_s},
           {"speedup_vs_bvh", reference_mrays_per_s > 0.0 ? s.mrays_per_s / reference_mrays_per_s : 0.0},
           {"bytes_ls", s.bytes_ls},
@@ -43,9 +57,15 @@ nlohmann::json side_json(const BudgetSide& s, double reference_mrays_per_s) {
 }  // namespace
 
 bool BudgetComparison::lower_rmse() const {
-  if (!refused.empty() || planned.rmse.size() != uniform.rmse.size()) return false;
-  for (size_t k = 0; k < planned.rmse.size(); ++k)
-    if (!(planned.rmse[k] < uniform.rmse[k])) return false;
+  if (!refused.empty() || planned.rmse.size() != uniform.rmse.size() || planned.bias.size() != planned.rmse.size() ||
+      uniform.bias.size() != uniform.rmse.size())
+    return false;
+  for (size_t k = 0; k < planned.rmse.size(); ++k) {
+    const bool estimated = planned.bias[k].valid() && uniform.bias[k].valid();
+    const double p = estimated ? planned.bias[k].rmse_bias : planned.rmse[k];
+    const double u = estimated ? uniform.bias[k].rmse_bias : uniform.rmse[k];
+    if (!(p < u)) return false;
+  }
   return true;
 }
 
@@ -59,7 +79,7 @@ BudgetStudy run_budget_study(StudyRenderer& renderer, const std::string& scene, 
   study.scene = scene;
   study.device = renderer.device();
   study.settings = settings;
-  const Reference reference = render_reference(renderer, settings);
+  Reference reference = render_reference(renderer, settings);
   study.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
   study.reference_bytes = reference.bytes;
   log("reference (bvh): " + fixed(study.reference_mrays_per_s, 2) + " MRays/s");
@@ -95,7 +115,8 @@ Table BudgetStudy::table() const {
   Table t;
   t.header = {"structure", "budget MB", "bytes_ls MB", "predicted MB", "MRays/s", "speed-up vs F-BVH"};
   for (int k = 1; k <= settings.bounces; ++k) t.header.push_back("RMSE from bounce " + std::to_string(k));
-  t.header.insert(t.header.end(), {"pilot error", "pilot saved work", "build s", "lower RMSE"});
+  for (int k = 1; k <= settings.bounces; ++k) t.header.push_back("rmse_bias from bounce " + std::to_string(k));
+  t.header.insert(t.header.end(), {"pilot error", "pilot saved work", "build s", "lower rmse_bias"});
   for (const BudgetComparison& r : rows) {
     if (!r.refused.empty()) {
       std::vector<std::string> line{r.uniform_name, "refused: " + r.refused};
@@ -107,6 +128,7 @@ Table BudgetStudy::table() const {
       std::vector<std::string> l{s.structure, mb(r.budget), mb(s.bytes_ls), predicted, fixed(s.mrays_per_s, 2),
                                  fixed(reference_mrays_per_s > 0.0 ? s.mrays_per_s / reference_mrays_per_s : 0.0, 2)};
       for (double e : s.rmse) l.push_back(rmse_text(e));
+      for (const BiasEstimate& b : s.bias) l.push_back(bias_text(b));
       l.insert(l.end(), {fixed(pilot.error, 5), fixed(pilot.saved_work, 2), fixed(s.build_seconds, 2), verdict});
       t.rows.push_back(l);
     };
@@ -142,7 +164,7 @@ nlohmann::json BudgetStudy::json() const {
       j["auto"] = side_json(r.planned, reference_mrays_per_s);
       j["auto"]["predicted_bytes"] = r.plan.predicted_bytes;
       j["auto"]["plan"] = ls_plan_json(r.plan);
-      j["lower_rmse_at_every_start_bounce"] = r.lower_rmse();
+      j["lower_rmse_at_every_start_bounce"] = r.lower_rmse();  // on rmse_bias
     }
     list.push_back(j);
   }

@@ -1,7 +1,7 @@
 // `linespace-validate budget`: the per-object choice of 2l-ls:auto (cpu/ls_budget.h) against uniform
 // parameters of the same memory.  For each uniform 2l-ls:D:N: its bytes_ls become the
 // budget of a 2l-ls:auto, and both are rendered from each start bounce against the all-exact reference
-// with the same random numbers (the measurement `rmse` makes): RMSE per start bounce, indirect MRays/s,
+// with the same random numbers (the measurement `rmse` makes): RMSE and rmse_bias per start bounce, indirect MRays/s,
 // memory (the plan's predicted bytes beside the built structure's), and the pilot's figures.
 #pragma once
 
@@ -20,6 +20,9 @@ namespace ls {
 struct BudgetSide {
   std::string structure;
   std::vector<double> rmse;  // from bounce 1..B
+  std::vector<BiasEstimate> bias;  // from bounce 1..B: rmse_bias, its standard error, the noise floor
+  std::vector<int> spp;            // from bounce 1..B
+  std::vector<std::string> spp_stop;
   double mrays_per_s = 0.0;  // with the structure from bounce 1
   size_t bytes_ls = 0;
   double build_seconds = 0.0;
@@ -31,7 +34,7 @@ struct BudgetComparison {
   BudgetSide uniform, planned;
   LsPlan plan;               // of the 2l-ls:auto
   std::string refused;       // non-empty: the uniform structure was refused (memory), no figures
-  bool lower_rmse() const;   // at every start bounce
+  bool lower_rmse() const;   // lower rmse_bias at every start bounce (RMSE without an estimate, 1 spp)
 };
 
 struct BudgetStudy {

@@ -20,6 +20,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <set>
@@ -29,26 +30,78 @@ namespace {
 
 using namespace ls;
 
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 // Image settings shared by every study.
 struct ImageFlags {
-  std::string size = "256x256";
-  int spp = 4, bounces = 3;
+  std::string size = "256x256", spp = "4";
+  int bounces = 3;
   uint32_t seed = 1;
+  // Empty: not given (one ImageFlags serves every subcommand, so the flags' own counts cannot tell).
+  std::string auto_rel_stderr, auto_seconds;
 
   void add_to(CLI::App* app) {
     app->add_option("--size", size, "WIDTHxHEIGHT")->capture_default_str();
-    app->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 16));
+    app->add_option("--spp", spp, "samples per pixel (1..65536), or auto: from " + std::to_string(kAutoStartSpp) +
+                                      ", doubled per configuration until rmse_bias is known to --auto-rel-stderr")
+        ->capture_default_str();
+    app->add_option("--auto-rel-stderr", auto_rel_stderr,
+                    "--spp auto: stop once rmse_bias's standard error is at most this fraction of it (default " +
+                        number_text(SppAuto{}.rel_stderr) + ")");
+    app->add_option("--auto-seconds", auto_seconds,
+                    "--spp auto: stop before a doubling that would end past this many seconds of a configuration "
+                    "(default " + number_text(SppAuto{}.seconds) + ")");
     app->add_option("--bounces", bounces, "indirect bounces after the primary hit")->capture_default_str()->check(CLI::Range(1, 64));
     app->add_option("--seed", seed)->capture_default_str();
+  }
+  static constexpr int kAutoStartSpp = 4;
+  // The whole text as a number, else NaN (which every range check refuses).
+  static double number(const std::string& text) {
+    size_t used = 0;
+    double v = NAN;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    return used == text.size() && used > 0 ? v : NAN;
   }
   ImageSettings settings() const {
     const Size s = parse_size(size);
     ImageSettings i;
     i.width = s.width;
     i.height = s.height;
-    i.spp = spp;
     i.bounces = bounces;
     i.seed = seed;
+    if (spp == "auto") {
+      const double rel = auto_rel_stderr.empty() ? SppAuto{}.rel_stderr : number(auto_rel_stderr);
+      const double seconds = auto_seconds.empty() ? SppAuto{}.seconds : number(auto_seconds);
+      if (!(rel > 0.0 && rel < 1.0))
+        throw InputError("--auto-rel-stderr " + auto_rel_stderr + ": expected a fraction in (0, 1)");
+      if (!(seconds > 0.0 && seconds <= 1e7))
+        throw InputError("--auto-seconds " + auto_seconds + ": expected seconds in (0, 1e7]");
+      i.spp = kAutoStartSpp;
+      i.auto_spp.enabled = true;
+      i.auto_spp.rel_stderr = rel;
+      i.auto_spp.seconds = seconds;
+    } else {
+      size_t used = 0;
+      long v = 0;
+      try {
+        v = std::stol(spp, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != spp.size() || v < 1 || v > (1 << 16))
+        throw InputError("--spp " + spp + ": expected an integer in [1, 65536] or auto");
+      if (!auto_rel_stderr.empty() || !auto_seconds.empty())
+        throw InputError("--auto-rel-stderr and --auto-seconds need --spp auto");
+      i.spp = int(v);
+    }
     return i;
   }
 };
@@ -225,9 +278,9 @@ int main(int argc, char** argv) {
       auto renderer = make_study_renderer(device, scene, ls_flags.options());
       const RmseStudy study = run_rmse_study(*renderer, scene_spec, specs, settings, out_dir, heatmap_max, log_line);
       write_rmse_study(out_dir, study);
-      std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\nwrote %s/{rmse.md, rmse.csv, rmse.json, *_heatmap.png, "
+      std::printf("%s, %ux%u, %s spp, %d bounces, %s\n\n%s\nwrote %s/{rmse.md, rmse.csv, rmse.json, *_heatmap.png, "
                   "*_side_by_side.png}\n",
-                  scene_spec.c_str(), settings.width, settings.height, settings.spp, settings.bounces,
+                  scene_spec.c_str(), settings.width, settings.height, image_flags.spp.c_str(), settings.bounces,
                   study.device.c_str(), study.summary().markdown().c_str(), out_dir.c_str());
     } else if (*sweep_cmd) {
       SweepGrid grid;
@@ -255,8 +308,8 @@ int main(int argc, char** argv) {
       auto renderer = make_study_renderer(device, scene, accel_options);
       const BudgetStudy study = run_budget_study(*renderer, scene_spec, specs, settings, accel_options.plan, log_line);
       write_budget_study(out_dir, study);
-      std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\n%s\nwrote %s/{budget.md, budget.csv, budget.json}\n", scene_spec.c_str(),
-                  settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
+      std::printf("%s, %ux%u, %s spp, %d bounces, %s\n\n%s\n%s\nwrote %s/{budget.md, budget.csv, budget.json}\n", scene_spec.c_str(),
+                  settings.width, settings.height, image_flags.spp.c_str(), settings.bounces, study.device.c_str(),
                   study.table().markdown().c_str(), study.choices().markdown().c_str(), out_dir.c_str());
     } else if (*policy_cmd) {
       const StructureSpec spec = parse_structure(policy_structure);
@@ -271,8 +324,8 @@ int main(int argc, char** argv) {
       auto renderer = make_study_renderer(device, scene, ls_flags.options());
       const PolicyStudy study = run_policy_study(*renderer, scene_spec, spec, starts, ts, settings, log_line, policy_repeats);
       write_policy_study(out_dir, study);
-      std::printf("%s, %ux%u, %d spp, %d bounces, %s\n\n%s\nwrote %s/{policy.md, policy.csv, policy.json}\n", scene_spec.c_str(),
-                  settings.width, settings.height, settings.spp, settings.bounces, study.device.c_str(),
+      std::printf("%s, %ux%u, %s spp, %d bounces, %s\n\n%s\nwrote %s/{policy.md, policy.csv, policy.json}\n", scene_spec.c_str(),
+                  settings.width, settings.height, image_flags.spp.c_str(), settings.bounces, study.device.c_str(),
                   study.markdown().c_str(), out_dir.c_str());
     } else if (*bound_cmd) {
       const std::vector<StructureSpec> specs = parse_structure_list(bound_structures);

@@ -58,10 +58,46 @@ double speedup(const PaperScene& s, const RmseRow* r) {
   return r && s.study.reference_mrays_per_s > 0.0 ? r->mrays_per_s / s.study.reference_mrays_per_s : NAN;
 }
 
-std::string verdict(int held, int total) {
+// An error with its standard error: rmse_bias where estimated, else the RMSE (1 spp) taken as exact.
+struct Err {
+  double value = NAN, se = 0.0;
+};
+
+Err error_of(double rmse, const BiasEstimate& b) { return b.valid() ? Err{b.rmse_bias, b.rmse_bias_stderr} : Err{rmse, 0.0}; }
+
+// Mean over scenes of the errors that exist, with the standard error of the mean (scenes independent).
+struct MeanErr {
+  double sum = 0.0, var = 0.0;
+  int n = 0;
+  void add(Err e) {
+    if (!std::isnan(e.value)) sum += e.value, var += e.se * e.se, ++n;
+  }
+  Err value() const { return n ? Err{sum / n, std::sqrt(var) / n} : Err{}; }
+};
+
+// -1: a below b by more than two standard errors of the difference; 1: above; 0: within them.
+int order(Err a, Err b) {
+  const double margin = 2.0 * std::sqrt(a.se * a.se + b.se * b.se);
+  if (a.value < b.value - margin) return -1;
+  if (a.value > b.value + margin) return 1;
+  return 0;
+}
+
+std::string err_text(Err e) {
+  if (!(e.se > 0.0)) return rmse_text(e.value);
+  BiasEstimate b;
+  b.rmse_bias = e.value;
+  b.rmse_bias_stderr = e.se;
+  return bias_text(b);
+}
+
+// held: the data shows the claim; undecided: within the noise; the rest contradicts it.
+std::string verdict(int held, int undecided, int total) {
   if (total == 0) return "not measured";
   if (held == total) return "holds";
-  if (held == 0) return "does not hold";
+  if (undecided == total) return "undecided";
+  if (held + undecided == total) return "holds where decided";
+  if (held == 0 && undecided == 0) return "does not hold";
   return "mixed";
 }
 
@@ -76,7 +112,8 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
   std::string md;
   const std::string device = report.scenes.front().study.device;
   md += "Ours: " + device + ", " + std::to_string(options.settings.width) + "x" + std::to_string(options.settings.height) +
-        ", " + std::to_string(options.settings.spp) + " spp, " + std::to_string(options.settings.bounces) +
+        ", " + (options.settings.auto_spp.enabled ? "--spp auto from " : "") + std::to_string(options.settings.spp) +
+        " spp, " + std::to_string(options.settings.bounces) +
         " bounces. Paper: i7-6800k + GTX 1080 (GLSL), 1024x1024.\n\n";
   if (options.tables.count(2)) {
     for (const PaperScene& s : report.scenes) {
@@ -112,17 +149,19 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
 
   // Averages over the scenes, as the paper averages over its five.
   std::map<std::string, Mean> speed, rmse1, rmse2, rmse3;
+  std::map<std::string, MeanErr> bias1, bias2, bias3;
   if (options.tables.count(3)) {
     md += "### Table 3 analogue: averaged over " + std::to_string(report.scenes.size()) +
-          " scene(s); speed-up of bounces >= 1 over F-BVH, RMSE with the structure from bounce 1, 2, 3\n\n";
+          " scene(s); speed-up of bounces >= 1 over F-BVH, RMSE (all samples, noise included) and rmse_bias ± its "
+          "standard error (the error of the expected images) with the structure from bounce 1, 2, 3\n\n";
     Table t;
-    t.header = {"structure", "speed-up", "paper speed-up", "RMSE 1", "RMSE 2", "RMSE 3", "paper RMSE 1", "paper RMSE 2",
-                "paper RMSE 3"};
-    t.rows.push_back({"F-BVH", "1.00", "1.00", "-", "-", "-", "-", "-", "-"});
+    t.header = {"structure", "speed-up", "paper speed-up", "RMSE 1", "RMSE 2", "RMSE 3", "rmse_bias 1", "rmse_bias 2",
+                "rmse_bias 3", "paper RMSE 1", "paper RMSE 2", "paper RMSE 3"};
+    t.rows.push_back({"F-BVH", "1.00", "1.00", "-", "-", "-", "-", "-", "-", "-", "-", "-"});
     Mean bvh2;
     for (const PaperScene& s : report.scenes) bvh2.add(speedup(s, row_of(s, "2l-bvh", 1)));
     t.rows.push_back({"2L-BVH", fixed(bvh2.value(), 2), fixed(paper::kTwoLevelBvhMraysPerS / paper::kFlatBvhMraysPerS, 2),
-                      "-", "-", "-", "-", "-", "-"});
+                      "-", "-", "-", "-", "-", "-", "-", "-", "-"});
     speed["2l-bvh"] = bvh2;
     for (const paper::Config* c : configs) {
       const std::string name = config_spec(*c).name();
@@ -134,20 +173,26 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
         rmse1[name].add(r1 ? r1->rmse : NAN);
         rmse2[name].add(r2 ? r2->rmse : NAN);
         rmse3[name].add(r3 ? r3->rmse : NAN);
+        bias1[name].add(r1 ? error_of(r1->rmse, r1->bias) : Err{});
+        bias2[name].add(r2 ? error_of(r2->rmse, r2->bias) : Err{});
+        bias3[name].add(r3 ? error_of(r3->rmse, r3->bias) : Err{});
       }
       t.rows.push_back({paper_name(*c), fixed(speed[name].value(), 2), fixed(c->mrays_per_s / paper::kFlatBvhMraysPerS, 2),
                         rmse_text(rmse1[name].value()), rmse_text(rmse2[name].value()), rmse_text(rmse3[name].value()),
+                        err_text(bias1[name].value()), err_text(bias2[name].value()), err_text(bias3[name].value()),
                         rmse_text(c->rmse[0]), rmse_text(c->rmse[1]), rmse_text(c->rmse[2])});
     }
     md += t.markdown() + "\n";
   }
 
   std::vector<Mean> t4_speed(paper::kSchedules.size()), t4_rmse(paper::kSchedules.size()), t4_mb(paper::kSchedules.size());
+  std::vector<MeanErr> t4_bias(paper::kSchedules.size());
   if (options.tables.count(4)) {
     md += "### Table 4 analogue: structure per bounce 1, 2, 3, averaged over " + std::to_string(report.scenes.size()) +
           " scene(s); speed-up of bounces >= 1 over the all-F-BVH schedule\n\n";
     Table t;
-    t.header = {"bounce 1, 2, 3", "our schedule", "MB", "speed-up", "RMSE", "paper MB", "paper speed-up", "paper RMSE"};
+    t.header = {"bounce 1, 2, 3", "our schedule", "MB", "speed-up", "RMSE", "rmse_bias", "paper MB", "paper speed-up",
+                "paper RMSE"};
     for (size_t i = 0; i < paper::kSchedules.size(); ++i) {
       for (const PaperScene& s : report.scenes) {
         const ScheduleMeasure& m = s.table4[i];
@@ -155,11 +200,13 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
         if (!m.refused.empty() || !base.refused.empty()) continue;
         t4_speed[i].add(m.mrays_per_s / base.mrays_per_s);
         t4_rmse[i].add(m.rmse);
+        t4_bias[i].add(error_of(m.rmse, m.bias));
         t4_mb[i].add(double(m.bytes) / 1e6);
       }
       const paper::ScheduleRow& p = paper::kSchedules[i];
       t.rows.push_back({p.paper_name, p.schedule, fixed(t4_mb[i].value(), 1), fixed(t4_speed[i].value(), 2),
-                        i == 0 ? "-" : rmse_text(t4_rmse[i].value()), fixed(p.mb, 1),
+                        i == 0 ? "-" : rmse_text(t4_rmse[i].value()), i == 0 ? "-" : err_text(t4_bias[i].value()),
+                        fixed(p.mb, 1),
                         fixed(p.mrays_per_s / paper::kSchedules[0].mrays_per_s, 2), p.rmse < 0 ? "-" : rmse_text(p.rmse)});
     }
     md += t.markdown() + "\n";
@@ -168,10 +215,13 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
   // ---- the paper's claims, checked on our data ----
   md += "### Which of the paper's claims hold here\n\n";
   nlohmann::json claims = nlohmann::json::array();
-  auto claim = [&](const std::string& text, int held, int total, const std::string& evidence) {
-    const std::string v = verdict(held, total);
-    md += "- **" + v + "** (" + std::to_string(held) + " of " + std::to_string(total) + "): " + text + ". " + evidence + "\n";
-    claims.push_back({{"claim", text}, {"verdict", v}, {"held", held}, {"checked", total}, {"evidence", evidence}});
+  auto claim = [&](const std::string& text, int held, int total, const std::string& evidence, int undecided = 0) {
+    const std::string v = verdict(held, undecided, total);
+    md += "- **" + v + "** (" + std::to_string(held) + " of " + std::to_string(total) +
+          (undecided ? ", " + std::to_string(undecided) + " within two standard errors" : "") + "): " + text + ". " +
+          evidence + "\n";
+    claims.push_back({{"claim", text}, {"verdict", v}, {"held", held}, {"checked", total}, {"undecided", undecided},
+                      {"evidence", evidence}});
   };
   if (options.tables.count(3)) {
     int held = 0, total = 0;
@@ -207,6 +257,7 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
     claim("two-level structures trace slower than their flat counterparts", held, total, ev);
 
     // Similar memory: each 2L-LS beside the F-LS whose memory is nearest on the same scene.
+    int undecided = 0;
     held = total = 0;
     ev.clear();
     for (const PaperScene& s : report.scenes)
@@ -223,41 +274,49 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
         }
         if (!best) continue;
         ++total;
-        held += l->rmse < best->rmse;
-        ev += l->structure + " " + rmse_text(l->rmse) + " (" + fixed(double(l->bytes) / 1e6, 1) + " MB) vs " +
-              best->structure + " " + rmse_text(best->rmse) + " (" + fixed(double(best->bytes) / 1e6, 1) + " MB); ";
+        const int o = order(error_of(l->rmse, l->bias), error_of(best->rmse, best->bias));
+        held += o < 0;
+        undecided += o == 0;
+        ev += l->structure + " " + err_text(error_of(l->rmse, l->bias)) + " (" + fixed(double(l->bytes) / 1e6, 1) +
+              " MB) vs " + best->structure + " " + err_text(error_of(best->rmse, best->bias)) + " (" +
+              fixed(double(best->bytes) / 1e6, 1) + " MB); ";
       }
-    claim("2L-LS is more accurate than F-LS of similar memory", held, total, ev);
+    claim("2L-LS is more accurate (rmse_bias) than F-LS of similar memory", held, total, ev, undecided);
 
-    held = total = 0;
+    held = total = undecided = 0;
     ev.clear();
     for (const paper::Config* c : configs) {
       const std::string name = config_spec(*c).name();
-      const double a = rmse1[name].value(), b = rmse2[name].value(), d = rmse3[name].value();
-      if (std::isnan(a) || std::isnan(b) || std::isnan(d)) continue;
+      const Err a = bias1[name].value(), b = bias2[name].value(), d = bias3[name].value();
+      if (std::isnan(a.value) || std::isnan(b.value) || std::isnan(d.value)) continue;
       ++total;
-      held += a > b && b > d;
-      if (!(a > b && b > d)) ev += name + " " + rmse_text(a) + "/" + rmse_text(b) + "/" + rmse_text(d) + "; ";
+      const int ab = order(a, b), bd = order(b, d);
+      held += ab > 0 && bd > 0;
+      undecided += ab >= 0 && bd >= 0 && !(ab > 0 && bd > 0);
+      if (!(ab > 0 && bd > 0)) ev += name + " " + err_text(a) + "/" + err_text(b) + "/" + err_text(d) + "; ";
     }
-    claim("starting the Line Space at a later bounce lowers the RMSE (Table 3's columns)", held, total,
-          ev.empty() ? "every structure: RMSE from bounce 1 > from 2 > from 3" : "exceptions: " + ev);
+    claim("starting the Line Space at a later bounce lowers the error (rmse_bias, Table 3's columns)", held, total,
+          ev.empty() ? "every structure: rmse_bias from bounce 1 > from 2 > from 3" : "exceptions: " + ev, undecided);
 
-    held = total = 0;
+    held = total = undecided = 0;
     ev.clear();
     for (const paper::Config* a : configs)
       for (const paper::Config* b : configs) {
         const bool deeper = a->kind == b->kind && a->subdivision == b->subdivision && a->depth < b->depth;
         const bool finer = a->kind == b->kind && a->depth == b->depth && a->subdivision < b->subdivision;
         if (!deeper && !finer) continue;
-        const double ea = rmse1[config_spec(*a).name()].value(), eb = rmse1[config_spec(*b).name()].value();
-        if (std::isnan(ea) || std::isnan(eb)) continue;
+        const Err ea = bias1[config_spec(*a).name()].value(), eb = bias1[config_spec(*b).name()].value();
+        if (std::isnan(ea.value) || std::isnan(eb.value)) continue;
         ++total;
-        held += eb < ea;
-        if (!(eb < ea))
-          ev += config_spec(*b).name() + " " + rmse_text(eb) + " not below " + config_spec(*a).name() + " " + rmse_text(ea) + "; ";
+        const int o = order(eb, ea);
+        held += o < 0;
+        undecided += o == 0;
+        if (o >= 0)
+          ev += config_spec(*b).name() + " " + err_text(eb) + (o == 0 ? " within noise of " : " not below ") +
+                config_spec(*a).name() + " " + err_text(ea) + "; ";
       }
-    claim("a deeper integration depth or a finer subdivision lowers the RMSE", held, total,
-          ev.empty() ? "every pair" : "exceptions: " + ev);
+    claim("a deeper integration depth or a finer subdivision lowers the error (rmse_bias)", held, total,
+          ev.empty() ? "every pair" : "exceptions: " + ev, undecided);
   }
   if (options.tables.count(2)) {
     int held = 0, total = 0;
@@ -278,14 +337,16 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
     claim("with instancing, 2L-LS needs far (here: over 4x) less Line Space memory than F-LS", held, total, ev);
   }
   if (options.tables.count(4)) {
-    int held = 0, total = 0;
+    int held = 0, total = 0, undecided = 0;
     std::string ev;
     // Rows 1 -> 2 start the same 2L-LS one bounce later; rows 6 -> 1 trade error for speed.
-    const double r_late = t4_rmse[1].value(), r_early = t4_rmse[2].value();
-    if (!std::isnan(r_late) && !std::isnan(r_early)) {
+    const Err r_late = t4_bias[1].value(), r_early = t4_bias[2].value();
+    if (!std::isnan(r_late.value) && !std::isnan(r_early.value)) {
       ++total;
-      held += r_late < r_early;
-      ev += "2l-ls:4:6 from bounce 3 " + rmse_text(r_late) + " vs from bounce 2 " + rmse_text(r_early) + "; ";
+      const int o = order(r_late, r_early);
+      held += o < 0;
+      undecided += o == 0;
+      ev += "2l-ls:4:6 from bounce 3 " + err_text(r_late) + " vs from bounce 2 " + err_text(r_early) + " (rmse_bias); ";
     }
     const double s_fls = t4_speed[6].value(), s_late = t4_speed[1].value();
     if (!std::isnan(s_fls) && !std::isnan(s_late)) {
@@ -294,7 +355,7 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
       ev += "speed-up: F-LS from bounce 2 " + fixed(s_fls, 2) + "x, 2L-LS from bounce 3 " + fixed(s_late, 2) + "x; ";
     }
     claim("per-bounce schedules trade error for speed as Table 4 shows (later LS: less error; more LS: more speed)", held,
-          total, ev);
+          total, ev, undecided);
   }
 
   report.markdown = md;
@@ -302,8 +363,10 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
   for (const PaperScene& s : report.scenes) {
     nlohmann::json t4 = nlohmann::json::array();
     for (const ScheduleMeasure& m : s.table4)
-      t4.push_back({{"paper", m.paper_name}, {"schedule", m.schedule}, {"rmse", m.rmse}, {"mrays_per_s", m.mrays_per_s},
-                    {"bytes", m.bytes}, {"refused", m.refused}});
+      t4.push_back({{"paper", m.paper_name}, {"schedule", m.schedule}, {"rmse", m.rmse},
+                    {"rmse_bias", number_or_null(m.bias.rmse_bias)}, {"rmse_bias_stderr", number_or_null(m.bias.rmse_bias_stderr)},
+                    {"noise_floor", number_or_null(m.bias.noise_floor)}, {"spp", m.spp}, {"spp_stop", m.spp_stop},
+                    {"mrays_per_s", m.mrays_per_s}, {"bytes", m.bytes}, {"refused", m.refused}});
     scenes.push_back({{"scene", s.scene}, {"triangles", s.triangles}, {"objects", s.objects}, {"instances", s.instances},
                       {"paper_scene", paper::kScenes[size_t(s.paper_scene)]}, {"study", s.study.json()}, {"table4", t4}});
   }
@@ -370,7 +433,7 @@ PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_opt
       }
     }
     if (options.tables.count(4)) {
-      const Reference reference = render_reference(*renderer, settings);
+      Reference reference = render_reference(*renderer, settings);
       for (const paper::ScheduleRow& s : paper::kSchedules) {
         ScheduleMeasure sm;
         sm.paper_name = s.paper_name;
@@ -378,13 +441,18 @@ PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_opt
         try {
           const Measured m = measure(*renderer, parse_schedule(s.schedule), settings, reference);
           sm.rmse = m.rmse;
+          sm.bias = m.bias;
+          sm.spp = m.spp;
+          sm.spp_stop = m.spp_stop;
           sm.mrays_per_s = m.mrays_per_s;
           sm.bytes = m.bytes;
         } catch (const InputError& e) {
           sm.refused = e.what();
         }
         log("Table 4 " + sm.schedule + ": " +
-            (sm.refused.empty() ? "RMSE " + rmse_text(sm.rmse) + ", " + fixed(sm.mrays_per_s, 2) + " MRays/s"
+            (sm.refused.empty() ? "RMSE " + rmse_text(sm.rmse) + ", rmse_bias " + bias_text(sm.bias) + " (" +
+                                      std::to_string(sm.spp) + " spp" + (sm.spp_stop.empty() ? "" : ", " + sm.spp_stop) +
+                                      "), " + fixed(sm.mrays_per_s, 2) + " MRays/s"
                                 : "refused: " + sm.refused));
         ps.table4.push_back(sm);
       }

@@ -1,7 +1,8 @@
 // `linespace-validate paper`: the paper's configurations over a list of scenes — Table 2's builds,
 // Table 3's structures with the LS from bounce 1..3, Table 4's per-bounce schedules — printed beside
 // the paper's figures (paper_figures.h) as ratios where absolute numbers are not comparable, followed
-// by which of the paper's claims hold on our scenes.
+// by which of the paper's claims hold on our scenes.  Claims about accuracy are decided on rmse_bias
+// (measure.h): a difference within two standard errors decides nothing and is reported as such.
 #pragma once
 
 #include "common/structure/accel.h"
@@ -26,6 +27,9 @@ struct PaperOptions {
 struct ScheduleMeasure {
   std::string paper_name, schedule;
   double rmse = 0.0, mrays_per_s = 0.0;
+  BiasEstimate bias;
+  int spp = 0;
+  std::string spp_stop;
   size_t bytes = 0;
   std::string refused;
 };

@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Plots a sweep written by `linespace-validate sweep`: speed-up over the exact F-BVH against RMSE,
+"""Plots a sweep written by `linespace-validate sweep`: speed-up over the exact F-BVH against the
+error (rmse_bias with its standard error as a bar; the RMSE where a point has no estimate, 1 spp),
 memory as marker size, one colour per family, the Pareto front joined by a line.
 
 Usage: plot_tradeoff.py SWEEP_DIR  (reads SWEEP_DIR/sweep.json, writes SWEEP_DIR/tradeoff.{png,svg})
@@ -19,6 +20,10 @@ def main(folder):
     points = [p for p in sweep["points"] if "rmse" in p]
     if not points:
         sys.exit("plot_tradeoff.py: the sweep holds no measured point")
+    biased = all(p.get("rmse_bias") is not None for p in points)
+    for p in points:
+        p["error"] = p["rmse_bias"] if biased else p["rmse"]
+        p["error_se"] = p["rmse_bias_stderr"] if biased else 0.0
     fig, ax = plt.subplots(figsize=(8, 5.5), dpi=120)
     colours = {"f-ls": "tab:blue", "2l-ls": "tab:orange"}
     biggest = max(p["bytes"] for p in points)
@@ -26,27 +31,31 @@ def main(folder):
         fam = [p for p in points if p["structure"].startswith(family + ":")]
         if not fam:
             continue
-        ax.scatter([p["rmse"] for p in fam], [p["speedup_vs_bvh"] for p in fam],
+        ax.errorbar([p["error"] for p in fam], [p["speedup_vs_bvh"] for p in fam],
+                    xerr=[p["error_se"] for p in fam], fmt="none", ecolor=colour, lw=0.8)
+        ax.scatter([p["error"] for p in fam], [p["speedup_vs_bvh"] for p in fam],
                    s=[30 + 600 * p["bytes"] / biggest for p in fam], c=colour, alpha=0.55,
                    edgecolors="black", linewidths=0.5, label=family.upper())
         for p in fam:
             label = "D%d N%d" % (p["depth"], p["subdivision"])
             if len({q["angle"] for q in points}) > 1:
                 label += " %g°" % p["angle"]
-            ax.annotate(label, (p["rmse"], p["speedup_vs_bvh"]), fontsize=6, xytext=(4, 3),
+            ax.annotate(label, (p["error"], p["speedup_vs_bvh"]), fontsize=6, xytext=(4, 3),
                         textcoords="offset points")
     # The exact F-BVH (RMSE 0, speed-up 1) is always on the front: nothing is more accurate.
-    front = [{"rmse": 0.0, "speedup_vs_bvh": 1.0}]
-    front += sorted((p for p in points if p["pareto"]), key=lambda p: p["rmse"])
-    front.sort(key=lambda p: (p["rmse"], -p["speedup_vs_bvh"]))
-    ax.plot([p["rmse"] for p in front], [p["speedup_vs_bvh"] for p in front], "k--", lw=1,
+    front = [{"error": 0.0, "speedup_vs_bvh": 1.0}]
+    front += [p for p in points if p["pareto"]]
+    front.sort(key=lambda p: (p["error"], -p["speedup_vs_bvh"]))
+    ax.plot([p["error"] for p in front], [p["speedup_vs_bvh"] for p in front], "k--", lw=1,
             label="Pareto front (with F-BVH)")
     ax.scatter([0.0], [1.0], marker="*", s=160, c="black", label="F-BVH (exact)")
     ax.axhline(1.0, color="grey", lw=0.5)
-    ax.set_xlabel("RMSE against the all-exact image (LS from bounce %d)" % sweep["start_bounce"])
+    ax.set_xlabel("%s against the all-exact image (LS from bounce %d)"
+                  % ("rmse_bias ± standard error" if biased else "RMSE", sweep["start_bounce"]))
     ax.set_ylabel("speed-up over F-BVH, bounces >= 1")
-    ax.set_title("%s, %dx%d, %d spp, %d bounces — marker area ∝ memory (largest %.1f MB)\n%s"
-                 % (sweep["scene"], sweep["width"], sweep["height"], sweep["spp"], sweep["bounces"],
+    spp = ("auto from %d" % sweep["spp"]) if sweep.get("spp_auto") else "%d" % sweep["spp"]
+    ax.set_title("%s, %dx%d, %s spp, %d bounces — marker area ∝ memory (largest %.1f MB)\n%s"
+                 % (sweep["scene"], sweep["width"], sweep["height"], spp, sweep["bounces"],
                     biggest / 1e6, sweep["device"]), fontsize=8)
     ax.legend(fontsize=8, markerscale=0.6)
     ax.grid(True, lw=0.3)

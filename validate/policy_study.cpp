@@ -14,13 +14,16 @@ const double kNan = std::nan("");
 
 std::string threshold_text(float t) { return shortest_text(t); }
 
+enum class Curve { Rmse, Bias, Threshold };
+
 // The throughput policy's points as (x, y), with the reference as T -> 0.
-std::vector<std::pair<double, double>> throughput_curve(const PolicyStudy& study, bool by_speed, bool threshold) {
+std::vector<std::pair<double, double>> throughput_curve(const PolicyStudy& study, bool by_speed, Curve y) {
   std::vector<std::pair<double, double>> curve;
   curve.push_back({by_speed ? study.reference_mrays_per_s : 0.0, 0.0});
   for (const PolicyPoint& p : study.points)
     if (p.policy == "throughput")
-      curve.push_back({by_speed ? p.mrays_per_s : p.fraction_on_x(), threshold ? double(p.threshold) : p.rmse});
+      curve.push_back({by_speed ? p.mrays_per_s : p.fraction_on_x(),
+                       y == Curve::Threshold ? double(p.threshold) : y == Curve::Bias ? p.bias.rmse_bias : p.rmse});
   return curve;
 }
 
@@ -65,10 +68,13 @@ std::vector<PolicyComparison> compare_policies(const PolicyStudy& study) {
     c.fraction_on_x = p.fraction_on_x();
     c.mrays_per_s = p.mrays_per_s;
     c.bounce_rmse = p.rmse;
-    c.throughput_rmse_at_fraction = interpolate(throughput_curve(study, false, false), c.fraction_on_x);
-    c.threshold_at_fraction = interpolate(throughput_curve(study, false, true), c.fraction_on_x);
-    c.throughput_rmse_at_speed = interpolate(throughput_curve(study, true, false), c.mrays_per_s);
-    c.threshold_at_speed = interpolate(throughput_curve(study, true, true), c.mrays_per_s);
+    c.throughput_rmse_at_fraction = interpolate(throughput_curve(study, false, Curve::Rmse), c.fraction_on_x);
+    c.threshold_at_fraction = interpolate(throughput_curve(study, false, Curve::Threshold), c.fraction_on_x);
+    c.throughput_rmse_at_speed = interpolate(throughput_curve(study, true, Curve::Rmse), c.mrays_per_s);
+    c.threshold_at_speed = interpolate(throughput_curve(study, true, Curve::Threshold), c.mrays_per_s);
+    c.bounce_rmse_bias = p.bias.rmse_bias;
+    c.throughput_rmse_bias_at_fraction = interpolate(throughput_curve(study, false, Curve::Bias), c.fraction_on_x);
+    c.throughput_rmse_bias_at_speed = interpolate(throughput_curve(study, true, Curve::Bias), c.mrays_per_s);
     out.push_back(c);
   }
   return out;
@@ -87,14 +93,16 @@ std::vector<float> parse_threshold_list(const std::string& text) {
 
 Table PolicyStudy::points_table() const {
   Table t;
-  t.header = {"policy", "start_bounce", "threshold", "fraction_on_x", "mrays_per_s", "speedup_vs_bvh", "rmse"};
+  t.header = {"policy", "start_bounce", "threshold", "fraction_on_x", "mrays_per_s", "speedup_vs_bvh", "rmse",
+              "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp", "spp_stop"};
   for (int k = 0; k <= settings.bounces; ++k) t.header.push_back("contribution_rmse_bounce_" + std::to_string(k));
   for (const PolicyPoint& p : points) {
     std::vector<std::string> line = {p.policy, p.policy == "bounce" ? std::to_string(p.start_bounce) : "",
                                      p.policy == "throughput" ? threshold_text(p.threshold) : "", fixed(p.fraction_on_x(), 6),
                                      fixed(p.mrays_per_s, 4),
                                      fixed(reference_mrays_per_s > 0.0 ? p.mrays_per_s / reference_mrays_per_s : 0.0, 4),
-                                     fixed(p.rmse, 6)};
+                                     fixed(p.rmse, 6), fixed(p.bias.rmse_bias, 6), fixed(p.bias.rmse_bias_stderr, 6),
+                                     fixed(p.bias.noise_floor, 6), std::to_string(p.spp), p.spp_stop};
     for (double c : p.contribution_rmse) line.push_back(fixed(c, 6));
     t.rows.push_back(line);
   }
@@ -103,24 +111,32 @@ Table PolicyStudy::points_table() const {
 
 Table PolicyStudy::comparison_table() const {
   Table t;
-  t.header = {"bounce policy", "rays on X", "MRays/s", "RMSE", "throughput policy, same rays on X: RMSE (T)",
-              "throughput policy, same MRays/s: RMSE (T)"};
+  t.header = {"bounce policy", "rays on X", "MRays/s", "RMSE", "rmse_bias",
+              "throughput policy, same rays on X: RMSE / rmse_bias (T)",
+              "throughput policy, same MRays/s: RMSE / rmse_bias (T)"};
   for (const PolicyComparison& c : comparisons) {
-    auto with_t = [](double rmse, double t) { return std::isnan(rmse) ? std::string("- (outside the thresholds)") : rmse_text(rmse) + " (" + fixed(t, 3) + ")"; };
+    auto with_t = [](double rmse, double bias, double t) {
+      return std::isnan(rmse) ? std::string("- (outside the thresholds)")
+                              : rmse_text(rmse) + " / " + rmse_text(bias) + " (" + fixed(t, 3) + ")";
+    };
     t.rows.push_back({"from bounce " + std::to_string(c.start_bounce), fixed(100.0 * c.fraction_on_x, 1) + " %",
-                      fixed(c.mrays_per_s, 2), rmse_text(c.bounce_rmse), with_t(c.throughput_rmse_at_fraction, c.threshold_at_fraction),
-                      with_t(c.throughput_rmse_at_speed, c.threshold_at_speed)});
+                      fixed(c.mrays_per_s, 2), rmse_text(c.bounce_rmse), rmse_text(c.bounce_rmse_bias),
+                      with_t(c.throughput_rmse_at_fraction, c.throughput_rmse_bias_at_fraction, c.threshold_at_fraction),
+                      with_t(c.throughput_rmse_at_speed, c.throughput_rmse_bias_at_speed, c.threshold_at_speed)});
   }
   return t;
 }
 
 std::string PolicyStudy::markdown() const {
   Table all;
-  all.header = {"policy", "rays on X", "MRays/s", "speed-up vs F-BVH", "RMSE"};
-  all.rows.push_back({"exact (reference)", "0.0 %", fixed(reference_mrays_per_s, 2), "1.00", rmse_text(0.0)});
+  all.header = {"policy", "rays on X", "MRays/s", "speed-up vs F-BVH", "spp", "RMSE", "rmse_bias ± stderr", "noise floor"};
+  all.rows.push_back({"exact (reference)", "0.0 %", fixed(reference_mrays_per_s, 2), "1.00", "-", rmse_text(0.0),
+                      rmse_text(0.0), "-"});
   for (const PolicyPoint& p : points)
     all.rows.push_back({p.policy + ", " + p.label(), fixed(100.0 * p.fraction_on_x(), 1) + " %", fixed(p.mrays_per_s, 2),
-                        fixed(reference_mrays_per_s > 0.0 ? p.mrays_per_s / reference_mrays_per_s : 0.0, 2), rmse_text(p.rmse)});
+                        fixed(reference_mrays_per_s > 0.0 ? p.mrays_per_s / reference_mrays_per_s : 0.0, 2),
+                        std::to_string(p.spp) + (p.spp_stop.empty() ? "" : " (" + p.spp_stop + ")"), rmse_text(p.rmse),
+                        bias_text(p.bias), rmse_text(p.bias.noise_floor)});
   std::string md = "X = " + structure + "; rays on X = share of the indirect rays (bounces >= 1) traced with X; MRays/s: median of " +
                    std::to_string(repeats) + " round-robin render" + (repeats == 1 ? "" : "s") + "\n\n";
   md += all.markdown() + "\nAt equal speed (the throughput policy interpolated between its neighbouring thresholds; "
@@ -130,12 +146,15 @@ std::string PolicyStudy::markdown() const {
 
 nlohmann::json PolicyStudy::json() const {
   nlohmann::json pts = nlohmann::json::array(), cmp = nlohmann::json::array();
-  auto number = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
+  const auto number = number_or_null;
   for (const PolicyPoint& p : points) {
     nlohmann::json j{{"policy", p.policy},          {"rmse", p.rmse},
                      {"mrays_per_s", p.mrays_per_s}, {"speedup_vs_bvh", reference_mrays_per_s > 0.0 ? p.mrays_per_s / reference_mrays_per_s : 0.0},
                      {"rays_on_x", p.rays_on_x},     {"indirect_rays", p.indirect_rays},
-                     {"fraction_on_x", p.fraction_on_x()}, {"contribution_rmse", p.contribution_rmse}};
+                     {"fraction_on_x", p.fraction_on_x()}, {"contribution_rmse", p.contribution_rmse},
+                     {"rmse_bias", number(p.bias.rmse_bias)}, {"rmse_bias_stderr", number(p.bias.rmse_bias_stderr)},
+                     {"noise_floor", number(p.bias.noise_floor)}, {"spp", p.spp}};
+    if (!p.spp_stop.empty()) j["spp_stop"] = p.spp_stop;
     if (p.policy == "bounce") j["start_bounce"] = p.start_bounce;
     else j["threshold"] = std::stod(threshold_text(p.threshold));  // 0.3, not 0.30000001192092896
     pts.push_back(j);
@@ -145,6 +164,9 @@ nlohmann::json PolicyStudy::json() const {
                    {"fraction_on_x", c.fraction_on_x},
                    {"mrays_per_s", c.mrays_per_s},
                    {"bounce_rmse", c.bounce_rmse},
+                   {"bounce_rmse_bias", number(c.bounce_rmse_bias)},
+                   {"throughput_rmse_bias_at_fraction", number(c.throughput_rmse_bias_at_fraction)},
+                   {"throughput_rmse_bias_at_speed", number(c.throughput_rmse_bias_at_speed)},
                    {"throughput_rmse_at_fraction", number(c.throughput_rmse_at_fraction)},
                    {"threshold_at_fraction", number(c.threshold_at_fraction)},
                    {"throughput_rmse_at_speed", number(c.throughput_rmse_at_speed)},
@@ -174,7 +196,7 @@ PolicyStudy run_policy_study(StudyRenderer& renderer, const std::string& scene, 
   study.settings = settings;
   study.repeats = repeats;
   study.structure_bytes = renderer.structure(structure).bytes_total();  // refused here if over the budget
-  const Reference reference = render_reference(renderer, settings);
+  Reference reference = render_reference(renderer, settings);
   study.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
   study.reference_bytes = reference.bytes;
   log("reference (bvh): " + fixed(study.reference_mrays_per_s, 2) + " MRays/s");
@@ -200,13 +222,17 @@ PolicyStudy run_policy_study(StudyRenderer& renderer, const std::string& scene, 
   speeds.back().push_back(study.reference_mrays_per_s);
   for (size_t i = 0; i < configs.size(); ++i) {
     auto& [p, options] = configs[i];
-    const Measured m = measure(renderer, options, reference);
+    const Measured m = measure(renderer, options, reference, settings.auto_spp);
     p.rmse = m.rmse;
     p.contribution_rmse = m.contribution_rmse;
+    p.bias = m.bias;
+    p.spp = m.spp;
+    p.spp_stop = m.spp_stop;
     speeds[i].push_back(m.mrays_per_s);
     rays_on_structure(m.result, study.structure, options.throughput_switch, p.rays_on_x, p.indirect_rays);
     log("[" + std::to_string(i + 1) + "/" + std::to_string(configs.size()) + "] " + p.policy + ", " + p.label() + ": " +
         fixed(100.0 * p.fraction_on_x(), 1) + " % of the rays on " + study.structure + ", RMSE " + rmse_text(p.rmse) +
+        ", rmse_bias " + bias_text(p.bias) + " (" + spp_text(m) + ")" +
         ", " + fixed(m.mrays_per_s, 2) + " MRays/s");
   }
   for (int r = 1; r < repeats; ++r) {

@@ -3,8 +3,8 @@
 //   bounce policy      exact F-BVH before bounce k, X from bounce k on (the paper's rule);
 //   throughput policy  exact F-BVH, except that a path whose throughput luminance is below T traces
 //                      that bounce's rays with X (render --throughput-switch T:X).
-// Every render uses the all-exact reference's random numbers, so RMSE (docs/design.md §7, as `rmse`) measures
-// the approximation alone.  Per configuration: RMSE, indirect MRays/s and the fraction of indirect
+// Every render uses the all-exact reference's random numbers; RMSE and rmse_bias as in `rmse`
+// (docs/design.md §7, measure.h).  Per configuration: RMSE, indirect MRays/s and the fraction of indirect
 // rays (bounces >= 1) traced with X.  Then, for each bounce-policy point, the throughput policy's RMSE
 // interpolated linearly between its two neighbouring points at the same fraction of rays on X, and at
 // the same MRays/s.  The fraction is exact and repeatable; MRays/s is timed, hence noisy on a shared
@@ -31,6 +31,9 @@ struct PolicyPoint {
   float threshold = 0.0f; // throughput policy: X below this throughput luminance
   double rmse = 0.0;
   std::vector<double> contribution_rmse;  // per bounce 0..B
+  BiasEstimate bias;                      // rmse_bias, its standard error, the noise floor
+  int spp = 0;
+  std::string spp_stop;                   // --spp auto: why it stopped adding samples
   double mrays_per_s = 0.0;
   uint64_t rays_on_x = 0, indirect_rays = 0;
   double fraction_on_x() const { return indirect_rays ? double(rays_on_x) / double(indirect_rays) : 0.0; }
@@ -44,6 +47,8 @@ struct PolicyComparison {
   double fraction_on_x = 0.0, mrays_per_s = 0.0, bounce_rmse = 0.0;
   double throughput_rmse_at_fraction = 0.0, threshold_at_fraction = 0.0;
   double throughput_rmse_at_speed = 0.0, threshold_at_speed = 0.0;
+  // The same on rmse_bias (NaN without an estimate): the comparison that does not move with spp.
+  double bounce_rmse_bias = 0.0, throughput_rmse_bias_at_fraction = 0.0, throughput_rmse_bias_at_speed = 0.0;
 };
 
 struct PolicyStudy {

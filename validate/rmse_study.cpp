@@ -37,8 +37,9 @@ Table RmseStudy::summary() const {
   Table t;
   t.header = {"structure", "MRays/s", "speed-up vs F-BVH", "MB"};
   for (int k = 1; k <= settings.bounces; ++k) t.header.push_back("RMSE from bounce " + std::to_string(k));
+  for (int k = 1; k <= settings.bounces; ++k) t.header.push_back("rmse_bias from bounce " + std::to_string(k));
   t.rows.push_back({"bvh (reference)", fixed(reference_mrays_per_s, 2), "1.00", fixed(double(reference_bytes) / 1e6, 1)});
-  for (int k = 1; k <= settings.bounces; ++k) t.rows.back().push_back("-");
+  for (int k = 1; k <= 2 * settings.bounces; ++k) t.rows.back().push_back("-");
   for (const RmseRow& r : rows) {
     if (r.start_bounce != 1) continue;
     std::vector<std::string> line = {r.structure};
@@ -53,6 +54,10 @@ Table RmseStudy::summary() const {
         const RmseRow* at = find(r.structure, k);
         line.push_back(at ? rmse_text(at->rmse) : "-");
       }
+      for (int k = 1; k <= settings.bounces; ++k) {
+        const RmseRow* at = find(r.structure, k);
+        line.push_back(at ? bias_text(at->bias) : "-");
+      }
     }
     t.rows.push_back(line);
   }
@@ -61,13 +66,19 @@ Table RmseStudy::summary() const {
 
 Table RmseStudy::detail() const {
   Table t;
-  t.header = {"structure", "start_bounce", "rmse", "mrays_per_s", "bytes"};
+  t.header = {"structure", "start_bounce", "rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp", "spp_stop",
+              "mrays_per_s", "bytes"};
   for (int k = 0; k <= settings.bounces; ++k) t.header.push_back("contribution_rmse_bounce_" + std::to_string(k));
   t.header.push_back("refused");
   for (const RmseRow& r : rows) {
     std::vector<std::string> line = {r.structure, std::to_string(r.start_bounce)};
     const bool ok = r.refused.empty();
     line.push_back(ok ? fixed(r.rmse, 6) : "");
+    line.push_back(ok ? fixed(r.bias.rmse_bias, 6) : "");
+    line.push_back(ok ? fixed(r.bias.rmse_bias_stderr, 6) : "");
+    line.push_back(ok ? fixed(r.bias.noise_floor, 6) : "");
+    line.push_back(ok ? std::to_string(r.spp) : "");
+    line.push_back(r.spp_stop);
     line.push_back(ok ? fixed(r.mrays_per_s, 4) : "");
     line.push_back(ok ? std::to_string(r.bytes) : "");
     for (int k = 0; k <= settings.bounces; ++k)
@@ -78,12 +89,35 @@ Table RmseStudy::detail() const {
   return t;
 }
 
+std::string RmseStudy::markdown() const {
+  Table t;
+  t.header = {"structure", "start bounce", "spp", "RMSE", "rmse_bias ± stderr", "noise floor"};
+  if (settings.auto_spp.enabled) t.header.push_back("--spp auto stopped");
+  for (const RmseRow& r : rows) {
+    if (!r.refused.empty()) continue;
+    t.rows.push_back({r.structure, std::to_string(r.start_bounce), std::to_string(r.spp), rmse_text(r.rmse),
+                      bias_text(r.bias), rmse_text(r.bias.noise_floor)});
+    if (settings.auto_spp.enabled) t.rows.back().push_back(r.spp_stop);
+  }
+  return summary().markdown() +
+         "\nRMSE: all samples, sampling noise included; rmse_bias: the error of the expected images, from two "
+         "independent halves of the samples, ± one standard error (docs/design.md §7). The heat-maps show the per-pixel "
+         "difference of the images averaged over both halves; the noise floor is the RMS of the sampling noise in that "
+         "difference (RMSE² ≈ rmse_bias² + noise floor²).\n\n" +
+         t.markdown();
+}
+
 nlohmann::json RmseStudy::json() const {
   nlohmann::json rows_json = nlohmann::json::array();
   for (const RmseRow& r : rows) {
     nlohmann::json j{{"structure", r.structure}, {"start_bounce", r.start_bounce}};
     if (r.refused.empty()) {
       j["rmse"] = r.rmse;
+      j["rmse_bias"] = number_or_null(r.bias.rmse_bias);
+      j["rmse_bias_stderr"] = number_or_null(r.bias.rmse_bias_stderr);
+      j["noise_floor"] = number_or_null(r.bias.noise_floor);
+      j["spp"] = r.spp;
+      if (!r.spp_stop.empty()) j["spp_stop"] = r.spp_stop;
       j["mrays_per_s"] = r.mrays_per_s;
       j["speedup_vs_bvh"] = reference_mrays_per_s > 0.0 ? r.mrays_per_s / reference_mrays_per_s : 0.0;
       j["bytes"] = r.bytes;
@@ -111,7 +145,7 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
   if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
 
   auto t0 = std::chrono::steady_clock::now();
-  const Reference reference = render_reference(renderer, settings);
+  Reference reference = render_reference(renderer, settings);
   study.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
   study.reference_bytes = reference.bytes;
   log("reference (bvh): " + fixed(seconds_since(t0), 2) + " s, " + fixed(study.reference_mrays_per_s, 2) + " MRays/s");
@@ -147,14 +181,20 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
       const Measured m = measure(renderer, schedule_from(spec, k), settings, reference);
       row.rmse = m.rmse;
       row.contribution_rmse = m.contribution_rmse;
+      row.bias = m.bias;
+      row.spp = m.spp;
+      row.spp_stop = m.spp_stop;
       row.mrays_per_s = m.mrays_per_s;
       study.rows.push_back(row);
       log("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + row.structure + " from bounce " +
-          std::to_string(k) + ": RMSE " + rmse_text(row.rmse) + ", " + fixed(row.mrays_per_s, 2) + " MRays/s, " +
+          std::to_string(k) + ": RMSE " + rmse_text(row.rmse) + ", rmse_bias " + bias_text(row.bias) + ", noise floor " +
+          rmse_text(row.bias.noise_floor) + " (" + spp_text(m) + "), " + fixed(row.mrays_per_s, 2) + " MRays/s, " +
           fixed(seconds_since(t0), 2) + " s");
+      // The heat-map shows the difference of the images averaged over both halves (all samples).
       if (!out_dir.empty())
         write_error_images(out_dir + "/" + file_safe(row.structure) + "_from_bounce_" + std::to_string(k),
-                           ref_image, as_image(m.result, m.result.total), reference.scale, heatmap_max);
+                           Image{m.result.width, m.result.height, m.reference_total}, as_image(m.result, m.result.total),
+                           reference.scale, heatmap_max);
     }
     if (release_structures) renderer.release(spec);
   }
@@ -163,7 +203,7 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
 
 void write_rmse_study(const std::string& dir, const RmseStudy& study) {
   std::filesystem::create_directories(dir);
-  write_text_file(dir + "/rmse.md", study.summary().markdown());
+  write_text_file(dir + "/rmse.md", study.markdown());
   write_text_file(dir + "/rmse.csv", study.detail().csv());
   write_text_file(dir + "/rmse.json", study.json().dump(2) + "\n");
 }

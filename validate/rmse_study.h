@@ -1,7 +1,8 @@
 // `linespace-validate rmse`: the paper's Table 3 on one scene.  The all-exact reference is rendered
 // once; then, for each structure S and start bounce k = 1..B, the image with the exact F-BVH before
 // bounce k and S from k on, with the same random numbers.  Speed is the MRays/s of bounces >= 1 with
-// S from bounce 1, beside the reference's in the same run.
+// S from bounce 1, beside the reference's in the same run.  Each row carries the RMSE (all samples,
+// noise included) and rmse_bias (the approximation's own error, measure.h) with its standard error.
 #pragma once
 
 #include "validate/measure.h"
@@ -19,6 +20,9 @@ struct RmseRow {
   int start_bounce = 1;
   double rmse = 0.0;
   std::vector<double> contribution_rmse;  // per bounce 0..B
+  BiasEstimate bias;                      // rmse_bias, rmse_bias_stderr, noise_floor
+  int spp = 0;
+  std::string spp_stop;                   // --spp auto: why it stopped adding samples
   double mrays_per_s = 0.0;
   size_t bytes = 0;                       // the structure's own
   size_t ls_nodes = 0, bytes_ls = 0;
@@ -34,8 +38,9 @@ struct RmseStudy {
   std::vector<RmseRow> rows;
 
   const RmseRow* find(const std::string& structure, int start_bounce) const;
-  Table summary() const;  // Table 3: one line per structure
+  Table summary() const;  // Table 3: one line per structure (RMSE and rmse_bias per start bounce)
   Table detail() const;   // one line per structure and start bounce, with per-bounce contributions
+  std::string markdown() const;  // rmse.md: the summary, then per row the spp, rmse_bias and noise floor
   nlohmann::json json() const;
 };
 
@@ -48,7 +53,7 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
                          const ImageSettings& settings, const std::string& out_dir, float heatmap_max, const Log& log,
                          bool release_structures = false);
 
-// rmse.md, rmse.csv (detail), rmse.json into dir.
+// rmse.md (the summary, then the detail's noise floors), rmse.csv (detail), rmse.json into dir.
 void write_rmse_study(const std::string& dir, const RmseStudy& study);
 
 std::string file_safe(const std::string& structure);  // f-ls:8:6 -> f-ls_8_6

@@ -66,14 +66,20 @@ std::vector<StructureKind> parse_families(const std::string& text) {
   return out;
 }
 
+namespace {
+
+double error_of(const SweepPoint& p) { return p.bias.valid() ? p.bias.rmse_bias : p.rmse; }
+
+}  // namespace
+
 void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s) {
   for (SweepPoint& p : points) {
     p.pareto = p.refused.empty() &&
-               !(reference_mrays_per_s >= p.mrays_per_s && (reference_mrays_per_s > p.mrays_per_s || p.rmse > 0.0));
+               !(reference_mrays_per_s >= p.mrays_per_s && (reference_mrays_per_s > p.mrays_per_s || error_of(p) > 0.0));
     for (const SweepPoint& q : points) {
       if (&q == &p || !q.refused.empty() || !p.pareto) continue;
-      const bool as_good = q.mrays_per_s >= p.mrays_per_s && q.rmse <= p.rmse;
-      const bool better = q.mrays_per_s > p.mrays_per_s || q.rmse < p.rmse;
+      const bool as_good = q.mrays_per_s >= p.mrays_per_s && error_of(q) <= error_of(p);
+      const bool better = q.mrays_per_s > p.mrays_per_s || error_of(q) < error_of(p);
       if (as_good && better) p.pareto = false;
     }
   }
@@ -81,12 +87,16 @@ void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s) 
 
 Table Sweep::table() const {
   Table t;
-  t.header = {"structure", "depth", "subdivision", "angle", "rmse", "mrays_per_s", "speedup_vs_bvh", "bytes",
-              "bytes_ls", "ls_nodes", "build_seconds", "pareto", "refused"};
+  t.header = {"structure", "depth", "subdivision", "angle", "rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp",
+              "spp_stop", "mrays_per_s", "speedup_vs_bvh", "bytes", "bytes_ls", "ls_nodes", "build_seconds", "pareto",
+              "refused"};
   for (const SweepPoint& p : points) {
     const bool ok = p.refused.empty();
     t.rows.push_back({p.structure, std::to_string(p.depth), std::to_string(p.subdivision), fixed(p.angle, 1),
-                      ok ? fixed(p.rmse, 6) : "", ok ? fixed(p.mrays_per_s, 4) : "", ok ? fixed(p.speedup, 4) : "",
+                      ok ? fixed(p.rmse, 6) : "", ok ? fixed(p.bias.rmse_bias, 6) : "",
+                      ok ? fixed(p.bias.rmse_bias_stderr, 6) : "", ok ? fixed(p.bias.noise_floor, 6) : "",
+                      ok ? std::to_string(p.spp) : "", p.spp_stop,
+                      ok ? fixed(p.mrays_per_s, 4) : "", ok ? fixed(p.speedup, 4) : "",
                       ok ? std::to_string(p.bytes) : "", ok ? std::to_string(p.bytes_ls) : "",
                       ok ? std::to_string(p.ls_nodes) : "", ok ? fixed(p.build_seconds, 3) : "",
                       p.pareto ? "1" : "0", p.refused});
@@ -100,11 +110,14 @@ nlohmann::json Sweep::json() const {
     nlohmann::json j{{"structure", p.structure}, {"depth", p.depth}, {"subdivision", p.subdivision},
                      {"angle", p.angle}, {"pareto", p.pareto}};
     if (p.refused.empty()) {
-      j.update({{"rmse", p.rmse}, {"mrays_per_s", p.mrays_per_s}, {"speedup_vs_bvh", p.speedup}, {"bytes", p.bytes},
+      j.update({{"rmse", p.rmse}, {"rmse_bias", number_or_null(p.bias.rmse_bias)},
+                {"rmse_bias_stderr", number_or_null(p.bias.rmse_bias_stderr)},
+                {"noise_floor", number_or_null(p.bias.noise_floor)}, {"spp", p.spp}, {"mrays_per_s", p.mrays_per_s}, {"speedup_vs_bvh", p.speedup}, {"bytes", p.bytes},
                 {"bytes_ls", p.bytes_ls}, {"ls_nodes", p.ls_nodes}, {"build_seconds", p.build_seconds}});
     } else {
       j["refused"] = p.refused;
     }
+    if (!p.spp_stop.empty()) j["spp_stop"] = p.spp_stop;
     pts.push_back(j);
   }
   nlohmann::json j = study_json(scene, device, settings, reference_mrays_per_s, reference_bytes);
@@ -123,7 +136,7 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
   sweep.device = renderer.device();
   sweep.settings = settings;
   sweep.start_bounce = grid.start_bounce;
-  const Reference reference = render_reference(renderer, settings);
+  Reference reference = render_reference(renderer, settings);
   sweep.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
   sweep.reference_bytes = reference.bytes;
   log("reference (bvh): " + fixed(sweep.reference_mrays_per_s, 2) + " MRays/s");
@@ -158,6 +171,9 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
           if (p.refused.empty()) {
             const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), at_angle, reference);
             p.rmse = m.rmse;
+            p.bias = m.bias;
+            p.spp = m.spp;
+            p.spp_stop = m.spp_stop;
             p.mrays_per_s = m.mrays_per_s;
             p.speedup = sweep.reference_mrays_per_s > 0.0 ? m.mrays_per_s / sweep.reference_mrays_per_s : 0.0;
             renderer.release(spec);
@@ -167,7 +183,8 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
           line += std::to_string(done) + "/" + std::to_string(total) + "] ";
           line += p.structure + " angle " + fixed(angle, 1) + ": ";
           if (p.refused.empty())
-            line += "RMSE " + rmse_text(p.rmse) + ", " + fixed(p.speedup, 2) + "x F-BVH, " +
+            line += "RMSE " + rmse_text(p.rmse) + ", rmse_bias " + bias_text(p.bias) + " (" + std::to_string(p.spp) +
+                    " spp" + (p.spp_stop.empty() ? "" : ", " + p.spp_stop) + "), " + fixed(p.speedup, 2) + "x F-BVH, " +
                     fixed(double(p.bytes) / 1e6, 1) + " MB";
           else
             line += "refused: " + p.refused;

@@ -28,8 +28,11 @@ struct SweepPoint {
   int depth = 0, subdivision = 0;
   float angle = 0.0f;
   double rmse = 0.0, mrays_per_s = 0.0, speedup = 0.0, build_seconds = 0.0;
+  BiasEstimate bias;         // rmse_bias: the accuracy the Pareto front is drawn on
+  int spp = 0;
+  std::string spp_stop;      // --spp auto: why it stopped adding samples
   size_t bytes = 0, bytes_ls = 0, ls_nodes = 0;
-  bool pareto = false;       // no other point (nor the exact F-BVH) is at least as fast and as accurate, and better in one
+  bool pareto = false;       // no other point (nor the exact F-BVH) is at least as fast and as accurate (rmse_bias), and better in one
   std::string refused;       // non-empty: not built (the reason)
 };
 
@@ -50,7 +53,9 @@ std::vector<float> parse_angle_list(const std::string& text);
 std::vector<StructureKind> parse_families(const std::string& text);
 
 Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings, const Log& log);
-// The exact reference (RMSE 0 at reference_mrays_per_s) takes part: a point it dominates is off the front.
+// On rmse_bias (sampling noise would move the front with spp; a point without an estimate, 1 spp,
+// falls back to its RMSE).  The exact reference (error 0 at reference_mrays_per_s) takes part: a point
+// it dominates is off the front.
 void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s);
 
 // sweep.csv, sweep.json, sweep.md into dir.

@@ -23,6 +23,9 @@ struct RenderOptions {
   uint32_t width = 512;
   uint32_t height = 512;
   uint32_t seed = 1;
+  // The sample indices are first_sample .. first_sample + spp - 1 (the random numbers' sample key): the
+  // validator renders one sample set as two disjoint halves (validate/split_render.h).  0: as ever.
+  uint32_t first_sample = 0;
   // The pixels to render, row-major indices in ascending order (a sharded render's tiles:
   // tile_selection.h); empty: every pixel.  The others stay black and trace no ray.  Random numbers are
   // keyed by the global pixel index, so a rendered pixel's value does not depend on which others are.

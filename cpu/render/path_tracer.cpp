@@ -104,7 +104,7 @@ RenderResult render(const Scene& scene, const std::map<std::string, Accel>& stru
 
   for (int s = 0; s < options.spp; ++s) {
     throw_if_interrupted();  // between passes and bounces: Ctrl-C stops within one batch
-    const uint32_t sample = uint32_t(s);
+    const uint32_t sample = options.first_sample + uint32_t(s);
     ls::parallel_for(size_t(0), order.size(), [&](size_t i) { shading.start_path(order[i], sample, cam, paths[order[i]]); });
 
     for (int k = 0; k <= bounces; ++k) {
