@@ -15,13 +15,13 @@ GpuAccel::GpuAccel(const VulkanContext& context, const Accel& accel)
       node_ls_(make_buffer(context, accel.node_ls, "node_ls")),
       ls_nodes_(make_buffer(context, accel.ls_nodes, "ls_nodes")),
       ls_candidates_(make_buffer(context, accel.ls_candidates, "ls_candidates")),
-      tri_normals_(make_buffer(context, accel.tri_normals, "tri_normals")) {
+      ls_records_(make_buffer(context, accel.ls_records, "ls_records")) {
   params_.ls_enabled = trace_context(accel).ls_enabled;  // the CPU's rule, so both sides agree
   params_.two_level = accel.spec.two_level() ? 1u : 0u;
 }
 
 std::vector<const Buffer*> GpuAccel::bindings() const {
-  return {&nodes_, &tris_, &tri_ids_, &tri_instances_, &top_nodes_, &instances_, &node_ls_, &ls_nodes_, &ls_candidates_, &tri_normals_};
+  return {&nodes_, &tris_, &tri_ids_, &tri_instances_, &top_nodes_, &instances_, &node_ls_, &ls_nodes_, &ls_candidates_, &ls_records_};
 }
 
 void GpuAccel::upload_candidates(const Accel& accel) {

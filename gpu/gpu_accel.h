@@ -26,7 +26,7 @@ class GpuAccel {
 
  private:
   const VulkanContext* context_;
-  Buffer nodes_, tris_, tri_ids_, tri_instances_, top_nodes_, instances_, node_ls_, ls_nodes_, ls_candidates_, tri_normals_;
+  Buffer nodes_, tris_, tri_ids_, tri_instances_, top_nodes_, instances_, node_ls_, ls_nodes_, ls_candidates_, ls_records_;
   lsk::ShaderParams params_{};
 };
 

@@ -469,7 +469,7 @@ size_t array_bytes(const std::vector<T>& v) {
 size_t expected_bytes(const ls::Accel& a) {
   return array_bytes(a.nodes) + array_bytes(a.tris) + array_bytes(a.tri_ids) + array_bytes(a.tri_instances) +
          array_bytes(a.top_nodes) + array_bytes(a.instances) + array_bytes(a.node_ls) + array_bytes(a.ls_nodes) +
-         array_bytes(a.ls_candidates) + array_bytes(a.tri_normals);
+         array_bytes(a.ls_candidates) + array_bytes(a.ls_records);
 }
 
 bool same_tri(const lsk::Triangle& t, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {

@@ -3,6 +3,7 @@
 #include "common/structure/accel.h"
 #include "common/structure/trace_context.h"
 #include "cpu/build/build_accel.h"
+#include "cpu/build/line_space_builder.h"
 #include "cpu/trace/ray_generators.h"
 #include "cpu/trace/trace_rays.h"
 #include "scenes/load_scene.h"
@@ -489,7 +490,8 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
   for (const Case& k : cases) {
     INFO(k.what);
     const std::vector<lsk::Triangle> tris = {horizontal(0.0f), k.u};
-    const std::vector<glm::uvec4> normals = {glm::uvec4(up), glm::uvec4(k.u_normal)};
+    const std::vector<lsk::LsRecord> records = {ls::make_ls_record(tris[0], glm::uvec3(up), 0u),
+                                                ls::make_ls_record(tris[1], glm::uvec3(k.u_normal), 1u)};
     for (uint32_t reverse : {0u, 1u}) {
       C c;
       c.tris = tris.data();
@@ -497,7 +499,7 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
       c.tri_instances = instances.data();
       c.ls_nodes = &node;
       c.ls_candidates = candidates.data();
-      c.tri_normals = normals.data();
+      c.ls_records = records.data();
       c.ls_cos2 = 0.5f;  // 45 degrees
       c.ls_reverse = reverse;
       const glm::vec3 origin(0.5f, 0.1f, 1e-4f), dir = glm::normalize(k.dir);

@@ -112,7 +112,7 @@ TEST_CASE("per-object Line Spaces with refusal angle 0 give the exact structure'
 TEST_CASE("2l-ls:auto stays within its budget and takes exactly the bytes it predicts", "[ls_budget]") {
   const Scene scene = load_scene(kScene);
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
-  const size_t fixed = exact.nodes.size() * 4 + exact.tris.size() * 16;
+  const size_t fixed = exact.nodes.size() * 4 + exact.tris.size() * sizeof(lsk::LsRecord);
   for (double extra_mb : {0.0, 0.02, 0.3, 3.0}) {
     const double mb = double(fixed) / 1e6 + extra_mb;
     INFO("budget " << mb << " MB");
@@ -152,7 +152,7 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
   // pilot's rays can look up.  A full build of the same structure must give the same answers.
   const Scene scene = load_scene(kScene);
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
-  const size_t fixed = exact.nodes.size() * 4 + exact.tris.size() * 16;
+  const size_t fixed = exact.nodes.size() * 4 + exact.tris.size() * sizeof(lsk::LsRecord);
   const AccelOptions options = with_budget(double(fixed) / 1e6 + 0.8, 6000);
   const Accel planned = build_planned_accel(scene, parse_structure("2l-ls:auto"), options);
   const LsPlan& plan = *planned.ls_plan;
@@ -184,7 +184,7 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
 TEST_CASE("2l-ls:auto is deterministic", "[ls_budget]") {
   const Scene scene = load_scene(kScene);
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
-  const double mb = double(exact.nodes.size() * 4 + exact.tris.size() * 16) / 1e6 + 0.5;
+  const double mb = double(exact.nodes.size() * 4 + exact.tris.size() * sizeof(lsk::LsRecord)) / 1e6 + 0.5;
   const Accel a = build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
   const Accel b = build_planned_accel(scene, parse_structure("2l-ls:auto"), with_budget(mb));
   CHECK(a.ls_options.objects == b.ls_options.objects);

@@ -201,7 +201,7 @@ struct ObjectSnapshot {
     add(a.node_ls);
     add(a.ls_nodes);
     add(a.ls_candidates);
-    add(a.tri_normals);
+    add(a.ls_records);
     fast_objects = a.fast->object_part();
     build_id = a.build_id;
     ls_seconds = a.ls_info.seconds;

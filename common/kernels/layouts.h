@@ -62,6 +62,22 @@ struct InstanceRecord {
   uint pad;
 };
 
+// What a lookup reads of a candidate triangle (docs/design.md §3), precomputed by the host per
+// triangle of the subtrees that get a Line Space: its plane and barycentric rows, so that the accept
+// decision reads one record (one cache line) and divides once.  For q = p - p0 of a point p on the
+// plane, the barycentric coordinates are dot(q, b1) and dot(q, b2).  A degenerate triangle (or one
+// whose rows overflow a float) has n = 0: the ray is parallel to it, and the lookup refuses.
+struct LsRecord {
+  vec3 p0;       // the first vertex
+  uint normal0;  // its vertex normal, octahedral (packSnorm2x16)
+  vec3 n;        // the unit plane normal, cross(v1 - v0, v2 - v0) normalised
+  uint normal1;
+  vec3 b1;       // cross(e2, n) / |n|^2 in double, rounded: the row of the second vertex's weight
+  uint normal2;
+  vec3 b2;       // cross(n, e1) / |n|^2: the third vertex's
+  uint id;       // tri_ids[] of the triangle
+};
+
 // A Line Space attached to one BVH node (docs/design.md §3).  Its box is the node's box, widened where it is
 // thin so that a flat node (one quad) still has shafts that cross it.  Candidates are stored per shaft
 // as an index local to the node's contiguous triangle range, in `bytes` bytes (1, 2 or 4, packed

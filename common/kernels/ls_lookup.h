@@ -1,6 +1,6 @@
 // The Line Space lookup during traversal (docs/design.md §3), a *context* file like traverse_bvh.h: it reads
-//   ls_nodes[] LsNode, ls_candidates[] uint, tri_normals[] uvec4 (octahedral vertex normals),
-//   tris[], tri_ids[], tri_instances[], the parameters ls_cos2 (cos^2 of the refusal angle;
+//   ls_nodes[] LsNode, ls_candidates[] uint, ls_records[] LsRecord (a candidate's plane, barycentric
+//   rows, vertex normals and id), tri_instances[], the parameters ls_cos2 (cos^2 of the refusal angle;
 //   negative: refuse everything, empty shafts included) and ls_reverse (non-zero: --ls-behind
 //   reverse, below), and the counters ls_counters.  N is the LS node's own (LsNode.n).
 //
@@ -69,38 +69,28 @@ LS_CONST uint LS_PLANE_BEHIND = 2u;
 LS_CONST uint LS_PLANE_BEYOND = 3u;
 LS_CONST uint LS_PLANE_ANGLE = 4u;
 
-// The candidate tris[prim] as an infinite plane: its hit t in [tmin, tmax] and the barycentrics
-// there, and the refusal angle's test on the vertex normals extrapolated to it.
+// The candidate ls_records[prim] as an infinite plane: its hit t in [tmin, tmax] and the
+// barycentrics there, and the refusal angle's test on the vertex normals extrapolated to it.
 LS_FN uint ls_plane_hit(uint prim, IN(vec3) origin, IN(vec3) dir, float tmin, float tmax, OUT(float) t_hit, OUT(float) u_hit,
                         OUT(float) v_hit) {
   t_hit = 0.0f;
   u_hit = 0.0f;
   v_hit = 0.0f;
-  Triangle tri = tris[prim];
-  vec3 p0 = vec3(tri.v0);
-  precise vec3 e1 = vec3(tri.v1) - p0;
-  precise vec3 e2 = vec3(tri.v2) - p0;
-  int ke = unit_exponent(max(max_abs(e1), max_abs(e2)));  // the cross product can neither over- nor underflow
-  vec3 e1s = scale_pow2(e1, ke);
-  vec3 e2s = scale_pow2(e2, ke);
-  precise vec3 n = cross(e1s, e2s);
-  precise float denom = dot_in_order(dir, n);
-  if (denom == 0.0f || dot_in_order(n, n) == 0.0f) return LS_PLANE_PARALLEL;
-  precise float t = dot_in_order(p0 - origin, n) / denom;
+  LsRecord rec = ls_records[prim];
+  precise float denom = dot_in_order(dir, rec.n);
+  if (denom == 0.0f) return LS_PLANE_PARALLEL;  // parallel, or a degenerate triangle (n = 0)
+  precise float t = dot_in_order(rec.p0 - origin, rec.n) / denom;
   t_hit = t;
   if (!(t >= tmin)) return LS_PLANE_BEHIND;
   if (!(t <= tmax)) return LS_PLANE_BEYOND;
   // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
-  precise vec3 q = origin + dir * t - p0;
-  precise float nn = dot_in_order(n, n);
-  vec3 qs = scale_pow2(q, ke);
-  precise float b1 = dot_in_order(cross(qs, e2s), n) / nn;
-  precise float b2 = dot_in_order(cross(e1s, qs), n) / nn;
+  precise vec3 q = origin + dir * t - rec.p0;
+  precise float b1 = dot_in_order(q, rec.b1);
+  precise float b2 = dot_in_order(q, rec.b2);
   precise float b0 = 1.0f - b1 - b2;
   u_hit = b1;
   v_hit = b2;
-  uvec4 packed = tri_normals[prim];
-  precise vec3 ne = ls_decode_normal(packed.x) * b0 + ls_decode_normal(packed.y) * b1 + ls_decode_normal(packed.z) * b2;
+  precise vec3 ne = ls_decode_normal(rec.normal0) * b0 + ls_decode_normal(rec.normal1) * b1 + ls_decode_normal(rec.normal2) * b2;
   precise float c = dot_in_order(dir, ne);
   precise float ne2 = dot_in_order(ne, ne);
   precise float lhs = c * c;
@@ -190,7 +180,7 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) box_lo, IN(vec3) box_hi, IN(vec3) o
   }
   // Only a hit as close as the current one meets the tie rule: offer_hit assumes t <= hit.t.
   uint inst = instance == LS_INVALID ? tri_instances[prim] : instance;
-  if (t <= hit.t && offer_hit(t, u, v, inst, tri_ids[prim], hit)) hit_prim = prim;
+  if (t <= hit.t && offer_hit(t, u, v, inst, ls_records[prim].id, hit)) hit_prim = prim;
   ls_counters.accepted += 1u;
   return LS_ACCEPTED;
 }

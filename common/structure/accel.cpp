@@ -20,7 +20,7 @@ std::vector<ObjectLs> LsPlan::objects(size_t meshes) const {
 
 size_t Accel::bytes_ls() const {
   return node_ls.size() * sizeof(uint32_t) + ls_nodes.size() * sizeof(lsk::LsNode) +
-         ls_candidates.size() * sizeof(uint32_t) + tri_normals.size() * sizeof(glm::uvec4);
+         ls_candidates.size() * sizeof(uint32_t) + ls_records.size() * sizeof(lsk::LsRecord);
 }
 
 size_t Accel::bytes_total() const {
@@ -46,7 +46,7 @@ lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
     c.node_ls = accel.node_ls.data();
     c.ls_nodes = accel.ls_nodes.data();
     c.ls_candidates = accel.ls_candidates.data();
-    c.tri_normals = accel.tri_normals.data();
+    c.ls_records = accel.ls_records.data();
     c.ls_enabled = 1;
     c.ls_cos2 = ls_cos2(lookup);
     c.ls_reverse = lookup.reverse_behind ? 1u : 0u;

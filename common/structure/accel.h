@@ -147,7 +147,7 @@ struct Accel {
   std::vector<uint32_t> node_ls;            // per BVH node: its LsNode, or LS_INVALID
   std::vector<lsk::LsNode> ls_nodes;
   std::vector<uint32_t> ls_candidates;      // packed per LsNode
-  std::vector<glm::uvec4> tri_normals;      // octahedral vertex normals per triangle (BVH order)
+  std::vector<lsk::LsRecord> ls_records;    // per triangle (BVH order): what a lookup reads of it
   LsBuildOptions ls_options;              // what its Line Space was built with
   LsBuildInfo ls_info;
   std::shared_ptr<const LsPlan> ls_plan;    // 2l-ls:auto: the per-object choice (ls_budget.h)

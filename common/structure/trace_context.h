@@ -23,7 +23,7 @@ struct TraceContext {
   const uint* node_ls = nullptr;
   const LsNode* ls_nodes = nullptr;
   const uint* ls_candidates = nullptr;
-  const uvec4* tri_normals = nullptr;
+  const LsRecord* ls_records = nullptr;
   uint ls_enabled = 0;
   float ls_cos2 = -1.0f;
   uint ls_reverse = 0;  // --ls-behind reverse (ls_lookup.h)

@@ -46,7 +46,7 @@ uint32_t candidate_bytes(uint32_t range_count, bool paper) {
   return 4;
 }
 
-glm::uvec4 encode_normals(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+glm::uvec3 encode_normals(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   auto enc = [](glm::vec3 n) -> uint32_t {
     const float l1 = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
     if (!(l1 > 0.0f) || !std::isfinite(l1)) return glm::packSnorm2x16(glm::vec2(0.0f));  // decodes to +z
@@ -56,16 +56,36 @@ glm::uvec4 encode_normals(const glm::vec3& a, const glm::vec3& b, const glm::vec
       e = glm::vec2((1.0f - std::fabs(n.y)) * (n.x >= 0.0f ? 1.0f : -1.0f), (1.0f - std::fabs(n.x)) * (n.y >= 0.0f ? 1.0f : -1.0f));
     return glm::packSnorm2x16(e);
   };
-  return glm::uvec4(enc(a), enc(b), enc(c), 0u);
+  return glm::uvec3(enc(a), enc(b), enc(c));
 }
 
-// Octahedral vertex normals per triangle of the structure, in the space of its BVH: world space for
-// F-LS (each instance's normal matrix applied), object space for 2L-LS, where only objects that get a
-// Line Space need them (the lookup reads the normals of candidates only).
 }  // namespace
 
-void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees, const LsBuildOptions& options, Accel& accel) {
-  accel.tri_normals.assign(accel.tris.size(), glm::uvec4(0u));
+lsk::LsRecord make_ls_record(const lsk::Triangle& tri, const glm::uvec3& normals, uint32_t id) {
+  lsk::LsRecord r{};
+  r.p0 = glm::vec3(tri.v0);
+  r.normal0 = normals.x;
+  r.normal1 = normals.y;
+  r.normal2 = normals.z;
+  r.id = id;
+  // In double: the rows are 1 / |edge| in size, and the cross product of float edges neither over-
+  // nor underflows there.
+  const glm::dvec3 p0(tri.v0), e1 = glm::dvec3(tri.v1) - p0, e2 = glm::dvec3(tri.v2) - p0;
+  const glm::dvec3 n = glm::cross(e1, e2);
+  const double nn = glm::dot(n, n);
+  if (!(nn > 0.0) || !std::isfinite(nn)) return r;  // degenerate: n = 0, refused as parallel
+  const glm::vec3 unit(n / std::sqrt(nn));
+  const glm::vec3 b1(glm::cross(e2, n) / nn), b2(glm::cross(n, e1) / nn);
+  const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!finite(unit) || !finite(b1) || !finite(b2)) return r;
+  r.n = unit;
+  r.b1 = b1;
+  r.b2 = b2;
+  return r;
+}
+
+void compute_line_space_records(const Scene& scene, const BvhSubtrees& subtrees, const LsBuildOptions& options, Accel& accel) {
+  accel.ls_records.assign(accel.tris.size(), lsk::LsRecord{});
   if (accel.spec.two_level()) {
     for (size_t m = 0; m < accel.object_roots.size(); ++m) {
       if (accel.object_roots[m] == lsk::LS_INVALID || object_line_space(accel, options, m).n <= 0) continue;
@@ -73,7 +93,8 @@ void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees,
       const uint32_t root = accel.object_roots[m];
       ls::parallel_for(subtrees.first[root], subtrees.first[root] + subtrees.count[root], [&](uint32_t k) {
         const glm::uvec3 idx = mesh.triangles[accel.tri_ids[k]];
-        accel.tri_normals[k] = encode_normals(mesh.normals[idx.x], mesh.normals[idx.y], mesh.normals[idx.z]);
+        accel.ls_records[k] =
+            make_ls_record(accel.tris[k], encode_normals(mesh.normals[idx.x], mesh.normals[idx.y], mesh.normals[idx.z]), accel.tri_ids[k]);
       });
     }
     return;
@@ -86,7 +107,8 @@ void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees,
     const Mesh& mesh = scene.meshes[scene.instances[inst].mesh];
     const glm::uvec3 idx = mesh.triangles[accel.tri_ids[k]];
     const glm::mat3& nm = normal_matrix[inst];
-    accel.tri_normals[k] = encode_normals(nm * mesh.normals[idx.x], nm * mesh.normals[idx.y], nm * mesh.normals[idx.z]);
+    accel.ls_records[k] = make_ls_record(
+        accel.tris[k], encode_normals(nm * mesh.normals[idx.x], nm * mesh.normals[idx.y], nm * mesh.normals[idx.z]), accel.tri_ids[k]);
   });
 }
 
@@ -175,7 +197,7 @@ size_t placement_bytes(const std::vector<LsPlacement>& placed) {
 }
 
 size_t line_space_fixed_bytes(const Accel& accel) {
-  return accel.nodes.size() * sizeof(uint32_t) + accel.tris.size() * sizeof(glm::uvec4);
+  return accel.nodes.size() * sizeof(uint32_t) + accel.tris.size() * sizeof(lsk::LsRecord);
 }
 
 ObjectLs object_line_space(const Accel& accel, const LsBuildOptions& options, size_t mesh) {
@@ -248,7 +270,7 @@ void layout_line_space_nodes(const LsBuildOptions& options, const Limits& limits
 void layout_line_space(const Scene& scene, const LsBuildOptions& options, const Limits& limits, Accel& accel) {
   const BvhSubtrees subtrees = bvh_subtrees(accel);
   layout_line_space_nodes(options, limits, subtrees, accel);
-  compute_line_space_normals(scene, subtrees, options, accel);
+  compute_line_space_records(scene, subtrees, options, accel);
 }
 
 void store_ls_candidate(Accel& accel, size_t ls_index, uint32_t shaft, uint32_t prim) {

@@ -24,8 +24,8 @@ struct Accel;
 void build_line_space(const Scene& scene, const LsBuildOptions& options, const Limits& limits, Accel& accel);
 
 // The part of the build both back ends share: chooses the LS nodes (boxes, subtree ranges, bytes per
-// candidate, word offsets), allocates accel.ls_candidates with every shaft empty, computes the vertex
-// normals and fills accel.ls_info (sizes; empty_shafts = every shaft until a search packs its result).
+// candidate, word offsets), allocates accel.ls_candidates with every shaft empty, computes the
+// candidate records and fills accel.ls_info (sizes; empty_shafts = every shaft until a search packs its result).
 void layout_line_space(const Scene& scene, const LsBuildOptions& options, const Limits& limits, Accel& accel);
 
 // The pieces of layout_line_space(), for callers that lay out many Line Spaces over one BVH (the
@@ -46,13 +46,16 @@ struct LsPlacement {
 std::vector<LsPlacement> place_line_spaces(const Accel& accel, const BvhSubtrees& subtrees, uint32_t root, int depth, int n,
                                            const LsBuildOptions& options);
 size_t placement_bytes(const std::vector<LsPlacement>& placed);  // LS node records + candidates
-// What bytes_ls() counts whatever the LS nodes: the per-node LS index and the per-triangle normals.
+// What bytes_ls() counts whatever the LS nodes: the per-node LS index and the per-triangle records.
 size_t line_space_fixed_bytes(const Accel& accel);
 // The D and N object `mesh` gets: options.objects' entry, else the structure's.
 ObjectLs object_line_space(const Accel& accel, const LsBuildOptions& options, size_t mesh);
-// The per-triangle vertex normals the lookup's refusal test reads (2L: objects with a Line Space only).
-void compute_line_space_normals(const Scene& scene, const BvhSubtrees& subtrees, const LsBuildOptions& options, Accel& accel);
-// Chooses the LS nodes, allocates empty candidates and fills ls_info (no normals).
+// The per-triangle records the lookup reads (2L: objects with a Line Space only; the rest stay zero).
+void compute_line_space_records(const Scene& scene, const BvhSubtrees& subtrees, const LsBuildOptions& options, Accel& accel);
+// One triangle's record: normals are its three vertex normals, octahedral (packSnorm2x16); id its
+// tri_ids[] entry.
+lsk::LsRecord make_ls_record(const lsk::Triangle& tri, const glm::uvec3& normals, uint32_t id);
+// Chooses the LS nodes, allocates empty candidates and fills ls_info (no records).
 void layout_line_space_nodes(const LsBuildOptions& options, const Limits& limits, const BvhSubtrees& subtrees, Accel& accel);
 // The candidate search of every laid-out LS node on all CPU threads; sets empty_shafts and seconds.
 void search_line_space(const LsBuildOptions& options, Accel& accel);

@@ -314,7 +314,7 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const AccelOptio
   plan.fixed_bytes = line_space_fixed_bytes(accel);
   if (plan.fixed_bytes > plan.budget)
     throw InputError("--ls-budget " + std::to_string(double(plan.budget) / 1e6) + " MB is below what any Line Space of this scene takes (" +
-                     std::to_string(double(plan.fixed_bytes) / 1e6) + " MB of per-triangle normals and per-node indices): raise --ls-budget");
+                     std::to_string(double(plan.fixed_bytes) / 1e6) + " MB of per-triangle candidate records and per-node indices): raise --ls-budget");
   const size_t room = plan.budget - plan.fixed_bytes;
   const size_t meshes = scene.meshes.size();
   const BvhSubtrees subtrees = bvh_subtrees(accel);
@@ -372,7 +372,7 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const AccelOptio
   LsBuildOptions scratch = options;
   scratch.progress = {};
   scratch.objects.assign(meshes, ObjectLs{0, 1});
-  compute_line_space_normals(scene, subtrees, scratch, accel);
+  compute_line_space_records(scene, subtrees, scratch, accel);
 
   // Every object's options, each evaluated with a Line Space on that object alone.
   const std::vector<ObjectLs> menu = ls_budget_menu();
@@ -507,7 +507,7 @@ LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const AccelOptio
   accel.node_ls.clear();
   accel.ls_nodes.clear();
   accel.ls_candidates.clear();
-  accel.tri_normals.clear();
+  accel.ls_records.clear();
   accel.ls_info = LsBuildInfo{};
   plan.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return plan;

@@ -13,8 +13,8 @@ namespace {
 // primitive reference and the order it returns (24 + 32 + 4 B, ~64 B), the flat build's world copy
 // (48 B); per node 32 B, at most 2 nodes per triangle.
 constexpr double kBytesPerTriangle = 48 + 8 + 64 + 48 + 2 * sizeof(lsk::BvhNode);
-// A Line Space adds per triangle its octahedral vertex normals (16 B) and per BVH node its LS index.
-constexpr double kLsBytesPerTriangle = sizeof(glm::uvec4) + 2 * sizeof(uint32_t);
+// A Line Space adds per triangle its candidate record (64 B) and per BVH node its LS index.
+constexpr double kLsBytesPerTriangle = sizeof(lsk::LsRecord) + 2 * sizeof(uint32_t);
 
 // At most this many LS nodes in a BVH over `triangles` at depth `depth` (double: 2^60 is fine).
 double ls_nodes_at_most(size_t triangles, int depth, uint32_t min_triangles) {

@@ -17,7 +17,7 @@ layout(std430, binding = 5) readonly buffer Instances { InstanceRecord instances
 layout(std430, binding = 6) readonly buffer NodeLs { uint node_ls[]; };
 layout(std430, binding = 7) readonly buffer LsNodes { LsNode ls_nodes[]; };
 layout(std430, binding = 8) readonly buffer LsCandidates { uint ls_candidates[]; };
-layout(std430, binding = 9) readonly buffer TriNormals { uvec4 tri_normals[]; };
+layout(std430, binding = 9) readonly buffer LsRecords { LsRecord ls_records[]; };
 
 layout(push_constant) uniform Params { ShaderParams pc; };  // common/kernels/layouts.h
 

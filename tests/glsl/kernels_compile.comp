@@ -23,7 +23,7 @@ layout(std430, binding = 5) readonly buffer Inst { InstanceRecord instances[]; }
 layout(std430, binding = 6) readonly buffer NodeLs { uint node_ls[]; };
 layout(std430, binding = 7) readonly buffer LsNodes { LsNode ls_nodes[]; };
 layout(std430, binding = 8) readonly buffer LsCand { uint ls_candidates[]; };
-layout(std430, binding = 9) readonly buffer Normals { uvec4 tri_normals[]; };
+layout(std430, binding = 9) readonly buffer Records { LsRecord ls_records[]; };
 layout(std430, binding = 10) buffer Rays { Ray rays[]; };
 layout(std430, binding = 11) buffer Hits { Hit hits[]; };
 layout(push_constant) uniform P { uint ls_enabled; uint ls_n; float ls_cos2; uint two_level; uint ls_reverse; } pc;

@@ -10,6 +10,7 @@ layout(std430, binding = 2) buffer BufferBvhNode { BvhNode vBvhNode[]; };
 layout(std430, binding = 3) buffer BufferTriangle { Triangle vTriangle[]; };
 layout(std430, binding = 4) buffer BufferInstanceRecord { InstanceRecord vInstanceRecord[]; };
 layout(std430, binding = 5) buffer BufferLsNode { LsNode vLsNode[]; };
+layout(std430, binding = 19) buffer BufferLsRecord { LsRecord vLsRecord[]; };
 layout(std430, binding = 6) buffer BufferLsCounters { LsCounters vLsCounters[]; };
 layout(std430, binding = 7) buffer BufferTraceWork { TraceWork vTraceWork[]; };
 layout(std430, binding = 8) buffer BufferCameraFrame { CameraFrame vCameraFrame[]; };
