@@ -106,8 +106,8 @@ void print_build(const Accel& a, bool json, const std::string& device) {
 
 void print_counters(const lsk::LsCounters& c) {
   std::fprintf(stderr,
-               "line space: %u lookups, %u empty shafts, %u accepted, refused %u (angle %u, behind the origin %u, "
-               "beyond the current t %u, parallel %u, no shaft %u)\n",
+               "line space: %u lookups, %u empty shafts, %u accepted, refused %u (angle %u, before the window %u, "
+               "past the window %u, parallel %u, no shaft %u)\n",
                c.lookups, c.empty, c.accepted,
                c.refused_angle + c.refused_behind + c.refused_beyond + c.refused_parallel + c.refused_no_shaft,
                c.refused_angle, c.refused_behind, c.refused_beyond, c.refused_parallel, c.refused_no_shaft);
