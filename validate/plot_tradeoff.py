@@ -31,8 +31,10 @@ def main(folder):
         fam = [p for p in points if p["structure"].startswith(family + ":")]
         if not fam:
             continue
+        # An RMSE is not negative: the bar stops at 0 on the left.
         ax.errorbar([p["error"] for p in fam], [p["speedup_vs_bvh"] for p in fam],
-                    xerr=[p["error_se"] for p in fam], fmt="none", ecolor=colour, lw=0.8)
+                    xerr=[[min(p["error"], p["error_se"]) for p in fam], [p["error_se"] for p in fam]],
+                    fmt="none", ecolor=colour, lw=0.8)
         ax.scatter([p["error"] for p in fam], [p["speedup_vs_bvh"] for p in fam],
                    s=[30 + 600 * p["bytes"] / biggest for p in fam], c=colour, alpha=0.55,
                    edgecolors="black", linewidths=0.5, label=family.upper())
