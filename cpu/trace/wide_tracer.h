@@ -53,11 +53,10 @@ struct SlabRay {
   uint32_t leave[3];
   bool parallel[3];   // safe_reciprocal's huge value: the ray runs parallel to that slab
   bool any_parallel;
-  bool by_sign;       // entry and exit taken from enter/leave (a finite ray), else as min and max
 };
 
 template <class Batch, class Node>
-LS_ALWAYS_INLINE void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const vec3& inv_dir, bool finite) {
+LS_ALWAYS_INLINE void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const vec3& inv_dir) {
   constexpr float big = 3.0e38f;
   constexpr uint32_t row = uint32_t(sizeof(Node::lo[0]));
   const float o[3] = {origin.x, origin.y, origin.z};  // indexed in memory, not through glm's switch
@@ -73,23 +72,22 @@ LS_ALWAYS_INLINE void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const
     r.parallel[a] = std::abs(inv[a]) == big;
   }
   r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
-  r.by_sign = finite;
 }
 
 template <class Batch, class Node>
-SlabRay<Batch> make_slab_ray(const vec3& origin, const vec3& inv_dir, bool finite) {
+SlabRay<Batch> make_slab_ray(const vec3& origin, const vec3& inv_dir) {
   SlabRay<Batch> r;
-  init_slab_ray<Batch, Node>(r, origin, inv_dir, finite);
+  init_slab_ray<Batch, Node>(r, origin, inv_dir);
   return r;
 }
 
 // lsk::ray_box on the lanes of a node whose rows start at `rows` (the node, plus the byte offset of
 // the first lane of the batch): the entry distance and the widened exit distance; a lane is hit
 // when near <= widened.  The scalar kernel's operations (slab_interval, widen_distance) lane by lane,
-// without fused multiply-adds (-ffp-contract=off).  For a finite ray each slab's entry and exit come
-// from the planes its direction says, not as min and max of the two: the same values (rounding is
-// monotone), up to the sign of a zero, which no comparison sees.
-template <bool kBySign, bool kParallel, class Batch>
+// without fused multiply-adds (-ffp-contract=off).  The walk takes finite rays only (order_free_ray),
+// so each slab's entry and exit come from the planes its direction says, not as min and max of the
+// two: the same values (rounding is monotone), up to the sign of a zero, which no comparison sees.
+template <bool kParallel, class Batch>
 LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, const Batch& tmin, const Batch& tmax, Batch& near,
                                  Batch& widened) {
   constexpr float big = 3.0e38f;
@@ -101,14 +99,9 @@ LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, cons
       const auto inside = (r.origin[a] >= row(r.lo[a])) && (r.origin[a] <= row(r.hi[a]));
       tn[a] = xsimd::select(inside, Batch(-big), Batch(big));
       tf[a] = xsimd::select(inside, Batch(big), Batch(-big));
-    } else if (kBySign) {
+    } else {
       tn[a] = (row(r.enter[a]) - r.origin[a]) * r.inv_dir[a];
       tf[a] = (row(r.leave[a]) - r.origin[a]) * r.inv_dir[a];
-    } else {
-      const Batch t0 = (row(r.lo[a]) - r.origin[a]) * r.inv_dir[a];
-      const Batch t1 = (row(r.hi[a]) - r.origin[a]) * r.inv_dir[a];
-      tn[a] = glm_min(t0, t1);
-      tf[a] = glm_max(t0, t1);
     }
   }
   near = glm_max(glm_max(tn[0], tn[1]), glm_max(tn[2], tmin));
@@ -141,7 +134,7 @@ LS_ALWAYS_INLINE unsigned exact_box_tests(const ExactWideNode<W>& node, const Ex
   for (int c = 0; c < W; c += int(Batch::size)) {
     Batch near;
     Batch widened;
-    slab_tests<true, kParallel>(reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c), r, tmin, tmax_batch, near,
+    slab_tests<kParallel>(reinterpret_cast<const char*>(&node) + sizeof(float) * size_t(c), r, tmin, tmax_batch, near,
                                 widened);
     near.store_aligned(tnear + c);
     bits |= lane_bits(near <= widened) << c;
@@ -391,7 +384,7 @@ class WideTracer final : public FastTracer {
     LazyBlockRay tri_ray;
     LS_ALWAYS_INLINE ObjectQuery(const vec3& o, const vec3& d, const vec3& inv, float t0, float t1, uint inst, bool any, bool ls)
         : origin(o), dir(d), inv_dir(inv), tmin(t0), tmax(t1), instance(inst), any_hit(any), use_ls(ls), tri_ray(o, d) {
-      init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, o, inv, true);
+      init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(exact_ray, o, inv);
     }
   };
 
@@ -499,7 +492,7 @@ class WideTracer final : public FastTracer {
     else
       [&]() __attribute__((noinline)) {  // its own function, with the instances' walks inlined in it (fewer spills)
         walk_exact(top_exact_, top_exact_.entry_of[0],
-                   make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir, true), ray.tmin, hit, instances,
+                   make_slab_ray<ExactBatch<W>, ExactWideNode<W>>(ray.origin, inv_dir), ray.tmin, hit, instances,
                    [](uint, uint) {});
       }();
     return lsk::finish_hit(hit);
