@@ -6,8 +6,10 @@
 // image code, so none of that is loaded.  Instruction counts of the traversal alone:
 //   valgrind --tool=callgrind --toggle-collect='ls::trace_rays*' linespace-profile SCENE STRUCTURE RAYS
 // Timing: the best of --repeat runs, in ns per ray (one thread; compare binaries, not machines).
+// --lookups: the Line Space lookups alone instead (lookup_timing.h).
 #include "common/base/ray_files.h"
 #include "common/structure/accel.h"
+#include "cpu/app/lookup_timing.h"
 #include "cpu/build/build_structures.h"
 #include "cpu/trace/embree_tracer.h"
 #include "cpu/trace/trace_rays.h"
@@ -28,7 +30,7 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
-               "--occlusion] [--ls-min-triangles M] [--ls-behind exact|reverse] [--embree-isa ISA] [--exact-width 4|8]\n");
+               "--occlusion | --lookups] [--ls-min-triangles M] [--ls-behind exact|reverse] [--embree-isa ISA] [--exact-width 4|8]\n");
   return 2;
 }
 
@@ -38,7 +40,7 @@ int main(int argc, char** argv) try {
   if (argc < 4) return usage();
   int repeat = 1;
   enum class Path { Fast, Reference, Embree } path = Path::Fast;
-  enum class Query { Closest, AnyHit, Occlusion } query = Query::Closest;
+  enum class Query { Closest, AnyHit, Occlusion, Lookups } query = Query::Closest;
   ls::AccelOptions options;
   ls::LsLookup lookup;
   std::string embree_isa = "best";  // valgrind 3.19 has no AVX-512: under it, "best" is Embree's avx2
@@ -49,6 +51,7 @@ int main(int argc, char** argv) try {
     else if (a == "--embree") path = Path::Embree;
     else if (a == "--any-hit") query = Query::AnyHit;
     else if (a == "--occlusion") query = Query::Occlusion;
+    else if (a == "--lookups") query = Query::Lookups;
     else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
     else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
     else if (a == "--ls-behind" && i + 1 < argc && (std::string(argv[i + 1]) == "exact" || std::string(argv[i + 1]) == "reverse"))
@@ -70,6 +73,10 @@ int main(int argc, char** argv) try {
     run = [&] { embree->trace(rays.data(), hits.data(), rays.size(), any_hit); };
   } else {
     accel = ls::build_planned_accel(scene, ls::parse_structure(argv[2]), options);
+    if (query == Query::Lookups) {
+      ls::time_lookups(accel, lookup, rays, repeat);
+      return 0;
+    }
     const ls::Traversal traversal = path == Path::Fast ? ls::Traversal::Fast : ls::Traversal::Reference;
     if (query == Query::Occlusion)
       run = [&] { ls::trace_occlusion(accel, lookup, rays.data(), hits.data(), rays.size(), nullptr, traversal); };
