@@ -59,12 +59,14 @@ inline float inversesqrt(float x) { return 1.0f / std::sqrt(x); }
 #define precise
 #define LS_CONST static constexpr
 #define LS_FN inline
+#define LS_CACHE_LINE alignas(64)  // host arrays of the struct start each element on a cache line
 #else
 #define IN(T) in T
 #define OUT(T) out T
 #define INOUT(T) inout T
 #define LS_CONST const
 #define LS_FN
+#define LS_CACHE_LINE
 #endif
 
 #endif

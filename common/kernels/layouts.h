@@ -64,10 +64,10 @@ struct InstanceRecord {
 
 // What a lookup reads of a candidate triangle (docs/design.md §3), precomputed by the host per
 // triangle of the subtrees that get a Line Space: its plane and barycentric rows, so that the accept
-// decision reads one record (one cache line) and divides once.  For q = p - p0 of a point p on the
+// decision reads one record (one cache line: aligned to it on the host) and divides once.  For q = p - p0 of a point p on the
 // plane, the barycentric coordinates are dot(q, b1) and dot(q, b2).  A degenerate triangle (or one
 // whose rows overflow a float) has n = 0: the ray is parallel to it, and the lookup refuses.
-struct LsRecord {
+struct LS_CACHE_LINE LsRecord {
   vec3 p0;       // the first vertex
   uint normal0;  // its vertex normal, octahedral (packSnorm2x16)
   vec3 n;        // the unit plane normal, cross(v1 - v0, v2 - v0) normalised

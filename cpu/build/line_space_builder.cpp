@@ -1,5 +1,6 @@
 #include "cpu/build/line_space_builder.h"
 
+#include "common/base/huge_pages.h"
 #include "common/base/interrupt.h"
 #include "common/base/memory_budget.h"
 #include "common/base/parallel.h"
@@ -85,7 +86,8 @@ lsk::LsRecord make_ls_record(const lsk::Triangle& tri, const glm::uvec3& normals
 }
 
 void compute_line_space_records(const Scene& scene, const BvhSubtrees& subtrees, const LsBuildOptions& options, Accel& accel) {
-  accel.ls_records.assign(accel.tris.size(), lsk::LsRecord{});
+  accel.ls_records.clear();
+  resize_huge(accel.ls_records, accel.tris.size());  // read at random by lookups: 2 MB pages spare TLB misses
   if (accel.spec.two_level()) {
     for (size_t m = 0; m < accel.object_roots.size(); ++m) {
       if (accel.object_roots[m] == lsk::LS_INVALID || object_line_space(accel, options, m).n <= 0) continue;
@@ -258,7 +260,9 @@ void layout_line_space_nodes(const LsBuildOptions& options, const Limits& limits
     info.candidate_bytes_compact += (uint64_t(shafts) * candidate_bytes(p.ls.range_count, false) + 3) / 4 * 4;
     subdivisions.insert(p.ls.n);
   }
-  accel.ls_candidates.assign(words, 0xFFFFFFFFu);  // all ones: every shaft empty until found
+  accel.ls_candidates.clear();
+  resize_huge(accel.ls_candidates, words);  // read at random by lookups, like the records
+  std::fill(accel.ls_candidates.begin(), accel.ls_candidates.end(), 0xFFFFFFFFu);  // all ones: every shaft empty until found
   info.ls_nodes = accel.ls_nodes.size();
   info.shafts_per_ls = subdivisions.size() == 1 ? lsk::ls_shaft_count(*subdivisions.begin())
                        : subdivisions.empty() && accel.spec.subdivision > 0 ? lsk::ls_shaft_count(uint32_t(accel.spec.subdivision))
