@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake ninja-build pkg-config ccache
-  libtbb-dev libxsimd-dev libglm-dev libopenimageio-dev openimageio-tools
+  libtbb-dev libxsimd-dev libglm-dev libopenexr-dev libpng-dev
   glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
   mesa-vulkan-drivers libvulkan-dev vulkan-tools
   python3-matplotlib   # linespace-validate sweep plots (validate/plot_tradeoff.py)
