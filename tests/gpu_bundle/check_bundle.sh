@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The GPU bundle (scripts/make-gpu-bundle.sh) runs with a cleared environment and nothing of the host
 # but its Vulkan driver; the library check of scripts/gpu_check.py finds a library the bundle lacks;
-# a driver file that names its library bare is resolved to a path the bundle's loader can open.
+# a driver file that names its library bare is resolved to a path the bundle's loader can open, also
+# when only LD_LIBRARY_PATH leads to it (where the original file fails).
 #   tests/gpu_bundle/check_bundle.sh BUILD_DIR      (ctest; needs a Vulkan device: lavapipe in CI)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -60,3 +61,22 @@ resolved=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["ICD
 [[ $(readlink -f "$resolved") == $(readlink -f "$lvp") ]] || die "bare $(basename "$lvp") resolved to '$resolved', not $lvp"
 env -i VK_DRIVER_FILES="$files" "$b/bin/linespace-gpu" devices | grep -q llvmpipe || die "lavapipe did not run through $files"
 say "bare $(basename "$lvp") resolved to $resolved"
+
+# 5. The case the rewrite is for: a driver named bare, in a folder only LD_LIBRARY_PATH names (as a
+#    container's GPU driver often is).  The bundle's loader cannot find it from the original file;
+#    from the rewritten one, with the folder passed on, it runs.
+mkdir -p "$tmp/driver/lib" "$tmp/driver/share/vulkan/icd.d"
+cp "$lvp" "$tmp/driver/lib/libplanteddriver.so.0"
+printf '{"file_format_version": "1.0.0", "ICD": {"library_path": "libplanteddriver.so.0", "api_version": "1.3.0"}}\n' \
+  > "$tmp/driver/share/vulkan/icd.d/planted_icd.json"
+if env -i VK_DRIVER_FILES="$tmp/driver/share/vulkan/icd.d/planted_icd.json" "$b/bin/linespace-gpu" devices > /dev/null 2>&1; then
+  die "the bundle found a driver that only LD_LIBRARY_PATH names without being told (the case proves nothing)"
+fi
+XDG_DATA_DIRS=$tmp/driver/share LD_LIBRARY_PATH=$tmp/driver/lib python3 "$root/scripts/gpu_check.py" icd "$tmp/icd-planted" \
+  > "$tmp/icd-planted.txt"
+files=$(sed -n 's/^VK_DRIVER_FILES=//p' "$tmp/icd-planted.txt" | tr ':' '\n' | grep planted_icd || true)
+extra=$(sed -n 's/^LINESPACE_EXTRA_LIBRARY_PATH=//p' "$tmp/icd-planted.txt")
+[[ -n $files ]] || die "the planted driver file was not rewritten: $(cat "$tmp/icd-planted.txt")"
+env -i VK_DRIVER_FILES="$files" LINESPACE_EXTRA_LIBRARY_PATH="$extra" "$b/bin/linespace-gpu" devices | grep -q llvmpipe ||
+  die "the rewritten driver file did not load: $(cat "$tmp/icd-planted.txt")"
+say "a driver only LD_LIBRARY_PATH names loads from its rewritten file"
