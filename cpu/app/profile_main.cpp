@@ -2,8 +2,8 @@
 //
 // It exists beside linespace-cpu so that a profile holds the traversal and nothing else: no command
 // line, no image or render code, one thread.  (It began because linespace-cpu then loaded OpenImageIO,
-// whose libhwy runs an instruction valgrind 3.19 does not know; the images now go through OpenEXR and
-// libpng.)  Instruction counts of the traversal alone:
+// whose libhwy runs an instruction valgrind 3.19 does not know; with OpenEXR and libpng valgrind
+// runs linespace-cpu too.)  Instruction counts of the traversal alone:
 //   valgrind --tool=callgrind --toggle-collect='ls::trace_rays*' linespace-profile SCENE STRUCTURE RAYS
 // Timing: the best of --repeat runs, in ns per ray (one thread; compare binaries, not machines).
 #include "common/base/ray_files.h"
