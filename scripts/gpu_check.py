@@ -104,6 +104,10 @@ def cmd_icd(out_dir):
             notes.append({"file": path, "library": None, "resolved": None, "how": "unreadable: %s" % e})
             continue
         resolved, how = resolve_library(library, os.path.dirname(os.path.abspath(path)))
+        if resolved and any(n["resolved"] and os.path.realpath(n["resolved"]) == os.path.realpath(resolved) for n in notes):
+            how += "; the same library as an earlier file, so skipped"  # else the device would be listed twice
+            notes.append({"file": path, "library": library, "resolved": None, "how": how})
+            continue
         notes.append({"file": path, "library": library, "resolved": resolved, "how": how})
         if not resolved:
             continue
