@@ -120,5 +120,6 @@ mv "$archive.tmp" "$archive"
 unpacked=$(du -sb "$stage" | cut -f1)
 packed=$(stat -c %s "$archive")
 mib() { awk -v b="$1" 'BEGIN {printf "%.1f", b / 1048576}'; }
-echo "make-gpu-bundle: $archive $(mib "$packed") MiB ($stage unpacked: $(mib "$unpacked") MiB, $(ls "$stage/lib" "$stage/lib-driver" | grep -c '\.so') libraries, scenes: ${scenes[*]:-built-in only})"
+shipped=("$stage"/lib/*.so* "$stage"/lib-driver/*.so*)
+echo "make-gpu-bundle: $archive $(mib "$packed") MiB ($stage unpacked: $(mib "$unpacked") MiB, ${#shipped[@]} libraries, scenes: ${scenes[*]:-built-in only})"
 ((packed <= limit_mib * 1048576)) || fail "$archive is $(mib "$packed") MiB, over the $limit_mib MiB that may be carried with the working tree"
