@@ -13,12 +13,6 @@ if(NOT TARGET xtl)
   add_library(xtl INTERFACE IMPORTED)
 endif()
 
-# OpenImageIO 2.4 lists /usr/include/opencv4 as an include directory even when OpenCV is absent.
-find_package(OpenImageIO REQUIRED)
-foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
-  get_target_property(dirs OpenImageIO::OpenImageIO ${prop})
-  if(dirs)
-    list(FILTER dirs EXCLUDE REGEX "opencv")
-    set_target_properties(OpenImageIO::OpenImageIO PROPERTIES ${prop} "${dirs}")
-  endif()
-endforeach()
+# Images: OpenEXR 3 for the linear EXRs (zip, custom header attributes), libpng for the PNGs.
+find_package(OpenEXR 3 REQUIRED)
+find_package(PNG REQUIRED)

@@ -2,6 +2,7 @@
 // cpu/cli_program.h) plus --device NAME|INDEX.  Line Space candidates are searched, rays traced and
 // paths shaded on the device; every figure is printed with the device's name.
 #include "cpu/app/cli_program.h"
+#include "gpu/device_list.h"
 #include "gpu/gpu_backend.h"
 
 int main(int argc, char** argv) {
@@ -11,5 +12,6 @@ int main(int argc, char** argv) {
   info.device_flag = true;
   info.fast_path_flags = false;  // the device traces with the shared kernels
   info.make_backend = [](const std::string& device) { return ls::gpu::make_gpu_backend(device); };
+  info.print_devices = ls::gpu::print_devices;
   return ls::run_program(argc, argv, info);
 }

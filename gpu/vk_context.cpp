@@ -30,6 +30,14 @@ int preference(VkPhysicalDeviceType t) {
   }
 }
 
+DeviceInfo basic_info(uint32_t index, const VkPhysicalDeviceProperties& p) {
+  DeviceInfo d;
+  d.index = index;
+  d.name = p.deviceName;
+  d.type = type_name(p.deviceType);
+  return d;
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -89,12 +97,37 @@ void check_vk(VkResult result, const char* what) {
 std::vector<DeviceInfo> VulkanContext::list_devices() {
   VkInstance instance = create_instance();
   std::vector<DeviceInfo> out;
-  uint32_t i = 0;
+  int preferred = -1;
+  VkPhysicalDeviceType preferred_type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
   for (VkPhysicalDevice d : physical_devices(instance)) {
     VkPhysicalDeviceProperties p;
     vkGetPhysicalDeviceProperties(d, &p);
-    out.push_back(DeviceInfo{i++, p.deviceName, type_name(p.deviceType)});
+    DeviceInfo info = basic_info(uint32_t(out.size()), p);
+    info.api_version = std::to_string(VK_API_VERSION_MAJOR(p.apiVersion)) + "." + std::to_string(VK_API_VERSION_MINOR(p.apiVersion)) +
+                       "." + std::to_string(VK_API_VERSION_PATCH(p.apiVersion));
+    info.vendor_id = p.vendorID;
+    info.device_id = p.deviceID;
+    info.max_storage_buffer_range = p.limits.maxStorageBufferRange;
+    if (p.apiVersion >= VK_API_VERSION_1_2) {  // driver properties are core from 1.2 on
+      VkPhysicalDeviceDriverProperties driver{};
+      driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
+      VkPhysicalDeviceProperties2 p2{};
+      p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+      p2.pNext = &driver;
+      vkGetPhysicalDeviceProperties2(d, &p2);
+      info.driver_name = driver.driverName;
+      info.driver_info = driver.driverInfo;
+    }
+    uint32_t bits = 0;
+    info.compute = compute_family(d, bits) != UINT32_MAX;
+    // The same rule as the constructor's choice without --device.
+    if (info.compute && (preferred < 0 || preference(p.deviceType) < preference(preferred_type))) {
+      preferred = int(out.size());
+      preferred_type = p.deviceType;
+    }
+    out.push_back(info);
   }
+  if (preferred >= 0) out[size_t(preferred)].preferred = true;
   vkDestroyInstance(instance, nullptr);
   return out;
 }
@@ -107,7 +140,7 @@ VulkanContext::VulkanContext(const std::string& device_choice) {
     std::vector<VkPhysicalDeviceProperties> props(devices.size());
     for (uint32_t i = 0; i < devices.size(); ++i) {
       vkGetPhysicalDeviceProperties(devices[i], &props[i]);
-      all.push_back(DeviceInfo{i, props[i].deviceName, type_name(props[i].deviceType)});
+      all.push_back(basic_info(i, props[i]));
     }
     int chosen = -1;
     if (!device_choice.empty()) {

@@ -17,6 +17,13 @@ struct DeviceInfo {
   uint32_t index = 0;
   std::string name;
   std::string type;  // "discrete", "integrated", "virtual", "cpu", "other"
+  // What `linespace-gpu devices` prints (empty where the device is older than Vulkan 1.2).
+  std::string api_version;  // "1.3.255"
+  std::string driver_name, driver_info;  // VkPhysicalDeviceDriverProperties: "NVIDIA", "550.54.15"
+  uint32_t vendor_id = 0, device_id = 0;
+  uint64_t max_storage_buffer_range = 0;
+  bool compute = false;    // has a compute queue
+  bool preferred = false;  // the one chosen without --device
 };
 
 class VulkanContext {
@@ -43,7 +50,7 @@ class VulkanContext {
   double timestamp_period_ns() const { return double(properties_.limits.timestampPeriod); }
   uint32_t memory_type(uint32_t type_bits, VkMemoryPropertyFlags wanted) const;
 
-  // Every device the loader reports (for messages and --device).
+  // Every device the loader reports (for messages, --device and `devices`); InputError without Vulkan.
   static std::vector<DeviceInfo> list_devices();
 
  private:

@@ -5,9 +5,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake ninja-build pkg-config ccache
-  libtbb-dev libxsimd-dev libglm-dev libopenimageio-dev openimageio-tools
+  libtbb-dev libxsimd-dev libglm-dev libopenexr-dev libpng-dev
   glslang-dev glslang-tools spirv-tools catch2 libtinygltf-dev libembree-dev nlohmann-json3-dev libcli11-dev
   mesa-vulkan-drivers libvulkan-dev vulkan-tools
+  libglvnd0 libglx0 libegl1 libx11-6 libxext6  # carried by the GPU bundle for a GPU driver (scripts/make-gpu-bundle.sh)
   python3-matplotlib   # linespace-validate sweep plots (validate/plot_tradeoff.py)
   valgrind             # scripts/profile-callgrind.sh (instructions a ray, docs/performance.md)
   python3 sweethome3d-furniture libcgal-demo  # the real scenes: assembler, sources (scenes/README.md)

@@ -63,6 +63,43 @@ TEST_CASE("linespace-gpu without any Vulkan driver exits 2 with a one-line reaso
   CHECK(r.status == 2);
   CHECK(line_count(r.err) == 1);
   CHECK(r.err.find("Vulkan") != std::string::npos);
+  const Run d = run(LINESPACE_GPU, "devices", "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json");
+  INFO(d.out << d.err);
+  CHECK(d.status == 2);
+  CHECK(line_count(d.err) == 1);
+}
+
+TEST_CASE("linespace-gpu devices names the device and driver that the other commands use", "[gpu_cli]") {
+  const Run j = run(LINESPACE_GPU, "devices --json");
+  INFO(j.out << j.err);
+  REQUIRE(j.status == 0);
+  const auto devices = nlohmann::json::parse(j.out).at("devices");
+  REQUIRE_FALSE(devices.empty());
+  // The default is the device `build` chooses without --device, and it reports it by the same name.
+  const Run b = run(LINESPACE_GPU, "build --structure bvh --json");
+  REQUIRE(b.status == 0);
+  const std::string used = nlohmann::json::parse(b.out).at("device");
+  size_t defaults = 0;
+  for (const auto& d : devices) {
+    const std::string name = d.at("name"), type = d.at("type");
+    CHECK(d.at("index") < devices.size());
+    CHECK(d.at("api_version").get<std::string>().find('.') != std::string::npos);
+    if (!d.at("default")) continue;
+    ++defaults;
+    CHECK(used.rfind(name + " (" + type + ", Vulkan ", 0) == 0);
+    CHECK_FALSE(d.at("driver_name").get<std::string>().empty());  // Vulkan 1.2 drivers, lavapipe too, name themselves
+    CHECK(d.at("compute") == true);
+    // --device INDEX picks the same one.
+    const Run by_index = run(LINESPACE_GPU, "build --structure bvh --json --device " + std::to_string(d.at("index").get<int>()));
+    REQUIRE(by_index.status == 0);
+    CHECK(nlohmann::json::parse(by_index.out).at("device") == used);
+  }
+  CHECK(defaults == 1);
+  const Run t = run(LINESPACE_GPU, "devices");
+  REQUIRE(t.status == 0);
+  CHECK(line_count(t.out) == devices.size());
+  CHECK(t.out.find("[default]") != std::string::npos);
+  CHECK(run(LINESPACE_CPU, "devices").status == 2);  // the CPU program has no devices to list
 }
 
 TEST_CASE("linespace-gpu trace writes the hit file linespace-cpu writes", "[gpu_cli]") {

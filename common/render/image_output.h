@@ -1,4 +1,4 @@
-// Images through OpenImageIO: linear float EXR, and an sRGB PNG for people to look at.
+// Images through OpenEXR and libpng: linear float EXR, and an sRGB PNG for people to look at.
 #pragma once
 
 #include <glm/glm.hpp>

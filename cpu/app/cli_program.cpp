@@ -64,6 +64,7 @@ struct Commands {
   CLI::App* render = nullptr;
   CLI::App* bench = nullptr;
   CLI::App* merge = nullptr;
+  CLI::App* devices = nullptr;
 };
 
 Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
@@ -127,6 +128,11 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.merge = app.add_subcommand("merge", "combine the partials of a sharded render into the single render's files");
   c.merge->add_option("--out", v.out_dir, "output folder")->required();
   c.merge->add_option("partials", v.partials, "partial EXRs written by render --shard or --tiles")->required();
+
+  if (info.print_devices) {
+    c.devices = app.add_subcommand("devices", "list the Vulkan devices and their drivers; marks the one chosen without --device");
+    c.devices->add_flag("--json", v.json, "machine-readable output");
+  }
 
   c.bench = app.add_subcommand("bench", "MRays/s of each structure on the same rays, in one run");
   common(c.bench, true);
@@ -249,6 +255,10 @@ void check_ray_budgets(const Commands& c, const Values& v) {
 
 void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   const ThreadLimit threads(v.threads.threads);  // first: a bad count is refused before any work
+  if (c.devices && *c.devices) {  // no scene, no structure
+    info.print_devices(v.json);
+    return;
+  }
   if (*c.build || *c.trace) check_budget_flag({parse_structure(v.structure)}, v);
   if (*c.render) {
     std::vector<StructureSpec> specs = parse_schedule(v.schedule).per_bounce;

@@ -22,6 +22,8 @@ struct ProgramInfo {
   bool fast_path_flags = true;  // --traversal, --wide-width, --exact-width: the CPU's fast path (not the GPU program)
   // Makes the backend once the command line is parsed, for the subcommands that need one.
   std::function<std::unique_ptr<Backend>(const std::string& device)> make_backend;
+  // `devices [--json]`: lists the devices the program can run on, with their drivers (the GPU program).
+  std::function<void(bool json)> print_devices;
 };
 
 int run_program(int argc, char** argv, const ProgramInfo& info);

@@ -1,9 +1,9 @@
 // linespace-profile: traces a ray file with one structure on one thread, for profilers.
 //
-// It exists beside linespace-cpu because callgrind cannot run that one here: linespace-cpu links
-// OpenImageIO, which loads libhwy, whose start-up code executes an instruction valgrind 3.19 does
-// not know (SIGILL) on these machines.  This program is linked with --as-needed and references no
-// image code, so none of that is loaded.  Instruction counts of the traversal alone:
+// It exists beside linespace-cpu so that a profile holds the traversal and nothing else: no command
+// line, no image or render code, one thread.  (It began because linespace-cpu then loaded OpenImageIO,
+// whose libhwy runs an instruction valgrind 3.19 does not know; with OpenEXR and libpng valgrind
+// runs linespace-cpu too.)  Instruction counts of the traversal alone:
 //   valgrind --tool=callgrind --toggle-collect='ls::trace_rays*' linespace-profile SCENE STRUCTURE RAYS
 // Timing: the best of --repeat runs, in ns per ray (one thread; compare binaries, not machines).
 // --lookups: the Line Space lookups alone instead (lookup_timing.h).
