@@ -2,6 +2,7 @@
 
 #include "common/base/interrupt.h"
 #include "common/base/memory_budget.h"
+#include "common/base/progress.h"
 #include "common/base/ray_files.h"
 #include "common/base/thread_limit.h"
 #include "common/render/backend.h"
@@ -21,7 +22,6 @@
 
 #include <cstdio>
 #include <iostream>
-#include <unistd.h>
 
 namespace ls {
 namespace {
@@ -169,14 +169,8 @@ RenderOptions render_options(const Values& v) {
 }
 
 Progress progress_bar(const Values& v) {
-  const bool show = !v.quiet && isatty(2);
-  return [show](int done, int total) {
-    if (!show) return;
-    const int width = 30, filled = done * width / total;
-    std::fprintf(stderr, "\rrender [%s%s] %d/%d samples", std::string(size_t(filled), '#').c_str(),
-                 std::string(size_t(width - filled), ' ').c_str(), done, total);
-    if (done == total) std::fprintf(stderr, "\n");
-  };
+  const ProgressLine line("render", "samples", !v.quiet && stderr_is_terminal());
+  return [line](int done, int total) { line.update(size_t(done), size_t(total)); };
 }
 
 // render --frames: the animation, frame by frame (render_frames.h).
@@ -311,7 +305,7 @@ int run_program(int argc, char** argv, const ProgramInfo& info) {
     std::cerr << info.name << ": " << e.what() << " (see --help)\n";
     return 2;
   }
-  v.ls.progress = isatty(2) && !v.quiet;
+  v.ls.progress = stderr_is_terminal() && !v.quiet;
   try {
     run(commands, v, info);
   } catch (const Interrupted& e) {
