@@ -119,7 +119,7 @@ TEST_CASE("render's default exposure shows a dim interior: its PNG's mean is bet
   CHECK(report(temp("ev0")).at("exposure").at("multiplier") == 1.0);
 }
 
-TEST_CASE("--exposure EV scales the PNG by 2^EV against the EXR; auto makes the log-average luminance 0.18", "[exposure_cli]") {
+TEST_CASE("render --exposure EV scales the PNG by 2^EV against the EXR, and auto makes the log-average luminance 0.18", "[exposure_cli]") {
   fs::remove_all(temp(""));
   const std::string args = "render --scene builtin:cornell --size 40x30 --spp 2 --bounces 2 --quiet --out ";
   for (const char* name : {"auto", "minus2", "plus1"}) {
@@ -160,7 +160,7 @@ TEST_CASE("--exposure EV scales the PNG by 2^EV against the EXR; auto makes the 
   CHECK(report(temp("plus1")).at("exposure").at("multiplier") == 2.0);
 }
 
-TEST_CASE("--exposure refuses what is not auto or a number of stops, with exit 2 and a one-line reason", "[exposure_cli]") {
+TEST_CASE("render --exposure refuses what is not auto or a number of stops, with exit 2 and a one-line reason", "[exposure_cli]") {
   fs::remove_all(temp(""));
   for (const char* bad : {"abc", "nan", "inf", "-inf", "1e9", "65", "2x", "''"}) {
     const Run r = run("render --scene builtin:cornell --size 8x8 --spp 1 --quiet --exposure " + std::string(bad) + " --out " +
