@@ -3,7 +3,7 @@
 // its lights' power: the key value of Reinhard et al. (2002), the log-average luminance of the lit
 // pixels (luminance > 0) becomes 0.18, middle grey.  Not the validator's 99th-percentile rule
 // (image_metrics.h, a scale for RMSE): where a ceiling light fills more than 1 % of the picture, as in
-// four of the five real scenes, that rule makes the light white and the room dark (PNG means 36-42 of
+// four of the five real scenes, that rule makes the light white and the room dark (PNG means 36-43 of
 // 255 against 119-123; docs/usage.md).  `--exposure EV` gives the multiplier 2^EV instead (0: the
 // radiance as is).  EXRs are never scaled.  The automatic choice reads the finished image only, in
 // pixel order, so the same image (a single render, or the merge of its shards) gets the same bits.
