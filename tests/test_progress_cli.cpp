@@ -1,6 +1,6 @@
 // The progress line of the long commands (common/base/progress.h) end to end: on a terminal (a
-// pseudo-terminal here) build, render and a validator study draw it on stderr; with stderr a pipe
-// they print nothing extra.
+// pseudo-terminal here) build, render and a validator study draw it on stderr, in linespace-gpu
+// (lavapipe) too; with stderr a pipe they print nothing extra.
 #include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
@@ -108,4 +108,20 @@ TEST_CASE("a validator study shows its renders' progress on a terminal, and only
   CHECK(!contains(study.piped.err, "\r"));
   CHECK(!contains(study.piped.err, "samples"));
   CHECK(contains(study.piped.err, "reference (bvh)"));  // the study's own log is still there
+}
+
+TEST_CASE("linespace-gpu's Line Space search and render show the progress line on a terminal, not in a pipe", "[progress_cli]") {
+  const BothWays build = run_both_ways(LINESPACE_GPU, "build --scene builtin:cornell --structure f-ls:5:4 --ls-min-triangles 0");
+  INFO("terminal: " << build.terminal.output << "\npiped: " << build.piped.err);
+  REQUIRE(build.terminal.status == 0);
+  REQUIRE(build.piped.status == 0);
+  CHECK(contains(build.terminal.output, "\rline space ["));
+  CHECK(build.piped.err.empty());
+  const BothWays render = run_both_ways(LINESPACE_GPU, "render --scene builtin:cornell --size 16x16 --spp 2 --bounces 1 --out " +
+                                                          temp("gpu_render").string());
+  INFO("terminal: " << render.terminal.output << "\npiped: " << render.piped.err);
+  REQUIRE(render.terminal.status == 0);
+  REQUIRE(render.piped.status == 0);
+  CHECK(contains(render.terminal.output, "] 2/2 samples"));
+  CHECK(render.piped.err.empty());
 }
