@@ -30,6 +30,11 @@ void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearch
     params.further_rays = uint32_t(accel.ls_options.further_rays);
     params.search_instance = ls_search_instance(accel);
     const size_t limit = std::min<size_t>(kBatchBytes, context.limits().maxStorageBufferRange);
+    // With a progress line, at most 1/32 of the nodes a submission, so that it moves (each node's
+    // search is its own: the candidates are the same).
+    const auto& progress = accel.ls_options.progress;
+    const size_t step = progress ? std::max<size_t>(1, (ls_count + 31) / 32) : ls_count;
+    size_t done = 0;
     // Consecutive LS nodes of one N share a dispatch (a structure of per-object N has several runs).
     for (size_t run = 0; run < ls_count;) {
       const uint32_t n = accel.ls_nodes[run].n;
@@ -38,7 +43,7 @@ void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearch
       const uint32_t shafts = lsk::ls_shaft_count(n);
       const size_t bytes_per_node = size_t(shafts) * sizeof(uint32_t);
       const size_t batch = std::max<size_t>(
-          1, std::min<size_t>({limit / bytes_per_node, run_end - run, context.limits().maxComputeWorkGroupCount[1]}));
+          1, std::min<size_t>({limit / bytes_per_node, run_end - run, context.limits().maxComputeWorkGroupCount[1], step}));
       Buffer prims(context, batch * bytes_per_node, "search results");
       std::vector<const Buffer*> bindings = gpu.bindings();
       bindings.push_back(&prims);
@@ -57,6 +62,8 @@ void search_candidates_gpu(const VulkanContext& context, Accel& accel, GpuSearch
         prims.download(host.data(), size_t(params.ls_count) * bytes_per_node);
         for (uint32_t slot = 0; slot < params.ls_count; ++slot)
           empty += pack_ls_candidates(accel, first + slot, host.data() + size_t(slot) * shafts);
+        done += params.ls_count;
+        if (progress) progress(done, ls_count);
       }
       run = run_end;
     }

@@ -1,9 +1,11 @@
 // Built-in procedural scenes, so that the default run needs no files.  Deterministic: a fixed
 // splitmix64 stream (no std::random_device, no std:: distributions, whose output is implementation-defined).
 //
-//   cornell            closed room [-1,1]^3 (floor, ceiling, back, front, red left, green right wall: one
-//                      object each, facing inwards), one emissive quad just below the ceiling, a tall and a
-//                      short box, a sphere and an icosahedron: 11 objects, 11 instances.
+//   cornell            the Cornell box as it is photographed: room [-1,1]^3 open at the front (floor,
+//                      ceiling, back, red left and green right wall: one object each, facing inwards),
+//                      one emissive quad flush in an opening of the ceiling, a tall and a short box, a
+//                      sphere and an icosahedron: 10 objects, 10 instances; the camera outside the open
+//                      front, looking in.
 //   instances          closed room [-7.5,7.5]x[0,6]x[-7.5,7.5] (6 wall objects), two ceiling lights, an
 //                      8x8 grid of 64 instances of ONE 51,200-triangle torus knot (own rotation and scale,
 //                      every fourth non-uniform) and three unique objects: 12 objects, 75 instances.
@@ -240,6 +242,9 @@ glm::mat4 rigid(const glm::vec3& position, float angle_y) {
 // Objects sit this far above the surface they rest on: coplanar faces would make hit ids ambiguous.
 constexpr float kGap = 1e-3f;
 
+// Half the width (x) and depth (z) of cornell's light: 130 x 105 of the classic 555-unit box.
+constexpr float kCornellLightX = 0.234f, kCornellLightZ = 0.189f;
+
 Scene cornell() {
   Scene s;
   const uint32_t white = add_material(s, "white", glm::vec3(0.73f));
@@ -251,9 +256,31 @@ Scene cornell() {
   const uint32_t blue = add_material(s, "sphere", {0.25f, 0.35f, 0.75f});
   const uint32_t gold = add_material(s, "icosahedron", {0.85f, 0.65f, 0.15f});
 
-  add_room(s, glm::vec3(-1.0f), glm::vec3(1.0f), {red, green, white, white, white, white});
-  // The classic 130 x 105 light of the 555-unit box, just below the ceiling.
-  add_ceiling_light(s, "light", 0.0f, 0.0f, 0.234f, 0.189f, 1.0f - 2e-3f, light);
+  // Open at the front (+z), as the classic box is photographed: five walls.
+  const glm::vec3 lo(-1.0f), hi(1.0f);
+  const char* names[5] = {"left wall", "right wall", "floor", "ceiling", "back wall"};
+  const uint32_t materials[5] = {red, green, white, white, white};
+  for (int w = 0; w < 5; ++w) {
+    Mesh m;
+    if (w == 3) {
+      // The ceiling around the light's opening, the classic 130 x 105 of the 555-unit box: the light
+      // fills it flush, so no gap above it lets a path reach its back or a ceiling point beside it at
+      // a millimetre's distance (the fireflies of a light hung below the ceiling).  Four trapezoids
+      // from the room's corners to the opening's: no T-junction with the walls or the light.
+      const glm::vec2 outer[4] = {{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}};
+      const glm::vec2 inner[4] = {{-kCornellLightX, -kCornellLightZ}, {kCornellLightX, -kCornellLightZ},
+                                  {kCornellLightX, kCornellLightZ}, {-kCornellLightX, kCornellLightZ}};
+      for (int k = 0; k < 4; ++k) {
+        const auto at = [](const glm::vec2& q) { return glm::vec3(q.x, 1.0f, q.y); };
+        // Corners in this order turn counter-clockwise seen from below: the trapezoid faces down.
+        add_quad(m, at(outer[k]), at(outer[(k + 1) % 4]), at(inner[(k + 1) % 4]), at(inner[k]), white);
+      }
+    } else {
+      add_box_face(m, lo, hi, w / 2, w % 2, true, materials[w]);
+    }
+    add_object(s, std::move(m), names[w]);
+  }
+  add_ceiling_light(s, "light", 0.0f, 0.0f, kCornellLightX, kCornellLightZ, 1.0f, light);
 
   Mesh tall_box, short_box, sphere, ico;
   add_box(tall_box, {0.3f, 0.6f, 0.3f}, tall, rigid({-0.35f, -0.4f + kGap, -0.35f}, 0.3f));
@@ -267,10 +294,12 @@ Scene cornell() {
   add_icosahedron(ico, {0.35f, -0.4f + 2.0f * kGap + 0.8507f * r, 0.3f}, r, gold);
   add_object(s, std::move(ico), "icosahedron");
 
-  s.camera.position = {0.0f, 0.0f, 0.97f};  // inside, just before the front wall
-  s.camera.target = {0.0f, 0.0f, -1.0f};
+  // The classic camera, scaled from the 555-unit box: 800 units before the open front, looking in,
+  // a 39.3 degree vertical field of view that just takes in the front opening.
+  s.camera.position = {0.0f, 0.0f, 1.0f + 800.0f * 2.0f / 555.0f};
+  s.camera.target = {0.0f, 0.0f, 0.0f};
   s.camera.up = {0.0f, 1.0f, 0.0f};
-  s.camera.yfov = 0.96f;
+  s.camera.yfov = 0.6859f;
   s.background = glm::vec3(0.0f);
   return s;
 }

@@ -33,7 +33,8 @@ Scene load_mesh_file(const std::string& path);
 Scene load_mesh_bytes(const std::string& bytes, const std::string& format, const std::string& name);
 
 // Built-in, deterministic scenes (no files):
-//   builtin:cornell                  closed room, several objects, one area light (the default scene)
+//   builtin:cornell                  the Cornell box seen through its open front, one light flush in the
+//                                    ceiling (the default scene)
 //   builtin:instances                room with 64 instances of one 51,200-triangle mesh + unique objects
 //   builtin:carousel                 animated (common/animation.h): 24 instances of two meshes riding,
 //                                    spinning, bobbing and pulsing, plus static unique objects

@@ -43,7 +43,7 @@ inline void require_same_render(const std::filesystem::path& single, const std::
   }
   REQUIRE(slurp(single / "image.png") == slurp(merged / "image.png"));
   const auto a = nlohmann::json::parse(slurp(single / "report.json")), b = nlohmann::json::parse(slurp(merged / "report.json"));
-  for (const char* key : {"scene", "schedule", "width", "height", "spp", "bounces", "seed", "dropped_samples"}) {
+  for (const char* key : {"scene", "schedule", "width", "height", "spp", "bounces", "seed", "dropped_samples", "exposure"}) {
     INFO(key);
     REQUIRE(a.at(key) == b.at(key));
   }

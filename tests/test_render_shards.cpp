@@ -63,7 +63,7 @@ struct Fixture {
     o.pixels = tile_pixels(grid, tiles);
     return render(scene, built, o);
   }
-  RenderReportContext context() const { return RenderReportContext{"builtin:cornell", options.schedule.name(), options.spp, options.seed, &built, "", nullptr, ThroughputSwitch{}}; }
+  RenderReportContext context() const { return RenderReportContext{"builtin:cornell", options.schedule.name(), options.spp, options.seed, &built, "", nullptr, ThroughputSwitch{}, ExposureRequest{}}; }
   // Writes the partial of `choice` into dir and returns its EXR path.
   std::string write(const ShardChoice& choice, const fs::path& dir, RenderOptions o) {
     o.pixels = tile_pixels(choice.grid, choice.tiles);

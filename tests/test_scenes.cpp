@@ -134,8 +134,9 @@ bool inside(const glm::vec3& p, const Bounds& b) {
 }
 
 // Properties every built-in has: valid, unit normals agreeing with the winding, distinct materials,
-// closed outward-facing solids, a closed inward-facing room when it has walls.
-void check_builtin(const Scene& s) {
+// closed outward-facing solids, a closed inward-facing room when it has walls.  open_front (cornell):
+// the room's walls and its lights, with a quad across the front, are closed; the camera is before it.
+void check_builtin(const Scene& s, bool open_front = false) {
   REQUIRE_NOTHROW(validate_scene(s));
   for (const Mesh& m : s.meshes) check_normals(m);
   std::set<std::string> names;
@@ -148,7 +149,8 @@ void check_builtin(const Scene& s) {
     const Mesh& m = s.meshes[inst.mesh];
     INFO("instance " << inst.name);
     const std::vector<glm::vec3> world = world_positions(s, inst);
-    if (m.name.find("wall") != std::string::npos || m.name == "floor" || m.name == "ceiling") {
+    const bool closes_room = open_front && m.name.find("light") != std::string::npos;  // flush in the ceiling
+    if (m.name.find("wall") != std::string::npos || m.name == "floor" || m.name == "ceiling" || closes_room) {
       for (const glm::uvec3& t : m.triangles) wall_tris.push_back(t + glm::uvec3(uint32_t(wall_pos.size())));
       wall_pos.insert(wall_pos.end(), world.begin(), world.end());
     } else if (m.name.find("light") == std::string::npos && m.name.find("blob") == std::string::npos) {
@@ -159,10 +161,23 @@ void check_builtin(const Scene& s) {
     }
   }
   if (!wall_tris.empty()) {
-    CHECK(closed_volume(wall_pos, wall_tris) < 0.0);  // the room faces inwards
     Bounds room;
     for (const glm::vec3& p : wall_pos) room.grow(p);
-    CHECK(inside(s.camera.position, room));
+    if (open_front) {  // a quad across z = max, facing into the room
+      const uint32_t b = uint32_t(wall_pos.size());
+      for (const glm::vec3& p : {glm::vec3(room.lo.x, room.lo.y, room.hi.z), glm::vec3(room.lo.x, room.hi.y, room.hi.z),
+                                 glm::vec3(room.hi.x, room.hi.y, room.hi.z), glm::vec3(room.hi.x, room.lo.y, room.hi.z)})
+        wall_pos.push_back(p);
+      wall_tris.push_back({b, b + 1, b + 2});
+      wall_tris.push_back({b, b + 2, b + 3});
+    }
+    CHECK(closed_volume(wall_pos, wall_tris) < 0.0);  // the room faces inwards
+    if (open_front) {
+      CHECK(s.camera.position.z > room.hi.z);
+      CHECK(inside(glm::vec3(s.camera.position.x, s.camera.position.y, room.centre().z), room));
+    } else {
+      CHECK(inside(s.camera.position, room));
+    }
     size_t outside = 0;  // everything is in the room
     for (const Instance& inst : s.instances)
       for (const glm::vec3& p : world_positions(s, inst))
@@ -176,30 +191,51 @@ void check_builtin(const Scene& s) {
 // ---------------------------------------------------------------------------------------------------
 // Built-in scenes
 
-TEST_CASE("builtin:cornell is a closed room with one light and several objects", "[scenes]") {
+TEST_CASE("builtin:cornell is the classic box: open front, a flush light, both blocks and coloured walls in view", "[scenes]") {
   const Scene s = load_scene("builtin:cornell");
   CHECK(s.name == "builtin:cornell");
-  CHECK(s.meshes.size() == 11);
-  CHECK(s.instances.size() == 11);
+  CHECK(s.meshes.size() == 10);
+  CHECK(s.instances.size() == 10);
   CHECK(triangle_count(s) < 10000);
-  check_builtin(s);
+  check_builtin(s, true);  // the walls and the light close the room but for its front
   size_t lights = 0, walls = 0;
   for (const Mesh& m : s.meshes) {
     if (emissive(s, m)) {
       ++lights;
       REQUIRE(m.triangles.size() == 2);
-      for (const glm::vec3& p : m.positions) CHECK(p.y < 1.0f);      // below the ceiling ...
+      for (const glm::vec3& p : m.positions) CHECK(p.y == 1.0f);      // flush with the ceiling ...
       for (const glm::vec3& n : m.normals) CHECK(n.y == Approx(-1)); // ... shining down
     }
     if (m.name.find("wall") != std::string::npos || m.name == "floor" || m.name == "ceiling") ++walls;
   }
   CHECK(lights == 1);
-  CHECK(walls == 6);
+  CHECK(walls == 5);
   // A red left and a green right wall, as seen from the camera (at +z, looking down -z).
   for (const Mesh& m : s.meshes) {
     if (m.name == "left wall") CHECK(s.materials[m.materials[0]].albedo.r > s.materials[m.materials[0]].albedo.g);
     if (m.name == "right wall") CHECK(s.materials[m.materials[0]].albedo.g > s.materials[m.materials[0]].albedo.r);
   }
+  // In view (square image): every vertex of both blocks, and the middle of both coloured walls.
+  const glm::vec3 forward = glm::normalize(s.camera.target - s.camera.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, s.camera.up)), up = glm::cross(right, forward);
+  const float half = std::tan(0.5f * s.camera.yfov);
+  const auto in_view = [&](const glm::vec3& p) {
+    const glm::vec3 d = p - s.camera.position;
+    const float z = glm::dot(d, forward);
+    return z > 0.0f && std::abs(glm::dot(d, right)) < half * z && std::abs(glm::dot(d, up)) < half * z;
+  };
+  size_t seen = 0;
+  for (const Instance& inst : s.instances) {
+    const std::string& name = s.meshes[inst.mesh].name;
+    INFO(name);
+    if (name == "tall box" || name == "short box") {
+      for (const glm::vec3& p : world_positions(s, inst)) CHECK(in_view(p));
+      ++seen;
+    }
+  }
+  CHECK(seen == 2);
+  CHECK(in_view({-1.0f, 0.0f, 0.0f}));
+  CHECK(in_view({1.0f, 0.0f, 0.0f}));
 }
 
 TEST_CASE("builtin:instances has 64 instances of one 50k-triangle mesh inside a room", "[scenes]") {

@@ -61,6 +61,18 @@ TEST_CASE("shards by --shard and by uneven --tiles, merged, equal the single ren
   const auto report = nlohmann::json::parse(slurp(temp("merged_policy") / "report.json"));
   REQUIRE(report.at("throughput_switch").at("structure") == "2l-ls:2:6");
   REQUIRE(report.at("per_bounce").at(2).at("switched_rays").get<int>() > 0);
+
+  // A given exposure travels in the partials: the merge exposes the PNG as the single run did.
+  const std::string exposure = "--exposure 1.5 ";
+  render_ok(exposure + "--out " + temp("single_ev").string());
+  for (int k = 0; k < 2; ++k) render_ok(exposure + "--shard " + std::to_string(k) + "/2 --out " + temp("ev").string());
+  m = cpu("merge --out " + temp("merged_ev").string() + " " + (temp("ev") / "partial-shard-0-of-2.exr").string() + " " +
+          (temp("ev") / "partial-shard-1-of-2.exr").string());
+  INFO(m.err);
+  REQUIRE(m.status == 0);
+  require_same_render(temp("single_ev"), temp("merged_ev"), 2);
+  REQUIRE(nlohmann::json::parse(slurp(temp("merged_ev") / "report.json")).at("exposure").at("ev") == 1.5);
+  REQUIRE(slurp(temp("single_ev") / "image.png") != slurp(temp("single") / "image.png"));
 }
 
 TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-line reason", "[shards_cli]") {
@@ -76,6 +88,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
   render_ok("--shard 1/3 --throughput-switch 0.3:bvh --out " + temp("switch").string(), base);
   render_ok("--shard 1/3 --out " + temp("schedule").string(), render_args("2", "2l-bvh"));
   render_ok("--shard 1/3 --out " + temp("tile").string(), render_args("2", "bvh", "9"));
+  render_ok("--shard 1/3 --exposure 2 --out " + temp("exposure").string(), base);
   REQUIRE(cpu("render --scene builtin:generated:500:2:1 --size 45x29 --spp 2 --bounces 2 --schedule bvh "
               "--tile-size 8 --quiet --shard 1/3 --out " + temp("scene").string()).status == 0);
   render_ok("--out " + temp("single").string(), base);
@@ -88,7 +101,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
                     s2 = part(parts, "partial-shard-2-of-3");
   const std::string out = " --out " + temp("refused").string() + " ";
   const std::string merge = "merge";
-  const std::array<std::pair<std::string, std::string>, 23> cases = {{
+  const std::array<std::pair<std::string, std::string>, 24> cases = {{
       {kRender + "--shard 3/3" + out, "K must be less than N"},
       {kRender + "--shard 1/0" + out, "N must be at least 1"},
       {kRender + "--shard 25/30" + out, "no tile"},
@@ -108,6 +121,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
       {merge + out + s0 + part(temp("schedule"), "partial-shard-1-of-3") + s2, "schedule is '2l-bvh'"},
       {merge + out + s0 + part(temp("switch"), "partial-shard-1-of-3") + s2, "throughput_switch is '0.3:bvh'"},
       {merge + out + s0 + part(temp("tile"), "partial-shard-1-of-3") + s2, "tile_size is '9'"},
+      {merge + out + s0 + part(temp("exposure"), "partial-shard-1-of-3") + s2, "exposure is {\"ev\":2.0,\"mode\":\"given\"}"},
       {merge + out + s0 + part(temp("scene"), "partial-shard-1-of-3") + s2, "the scene differs"},
       {merge + out + s0 + " " + (temp("single") / "total.exr").string() + s2, "is not a linespace partial"},
       {merge + out + s0 + " " + truncated.string() + s2, "cannot read"},

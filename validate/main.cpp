@@ -2,6 +2,7 @@
 // speed and memory (docs/design.md §7, §9).
 // Exit status: 0 success, 1 a check failed, 2 bad input or usage (one-line reason on stderr).
 #include "common/base/memory_budget.h"
+#include "common/base/progress.h"
 #include "common/base/ray_files.h"
 #include "common/base/thread_limit.h"
 #include "common/structure/accel.h"
@@ -260,6 +261,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  ls_flags.progress = stderr_is_terminal();  // Line Space builds: a progress line on a terminal
   // The image settings of the studies, with the Line Space lookup of --ls-angle and --ls-behind.
   const auto image_settings = [&] {
     ImageSettings s = image_flags.settings();

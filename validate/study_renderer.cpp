@@ -1,5 +1,6 @@
 #include "validate/study_renderer.h"
 
+#include "common/base/progress.h"
 #include "common/base/system_info.h"
 #include "common/render/backend.h"
 #include "common/render/render_types.h"
@@ -28,7 +29,11 @@ const Accel& StudyRenderer::structure(const StructureSpec& spec) {
 
 RenderResult StudyRenderer::render(const RenderOptions& options) {
   for (const StructureSpec& spec : render_structures(options)) structure(spec);  // the switch's too
-  return backend_->render(scene_, built_, options, {});
+  // On a terminal, each render's samples; erased when done (the study's log says what finished).
+  const ProgressLine line("render", "samples", stderr_is_terminal(), ProgressEnd::Erase);
+  Progress progress;
+  if (line.enabled()) progress = [line](int done, int total) { line.update(size_t(done), size_t(total)); };
+  return backend_->render(scene_, built_, options, progress);
 }
 
 void StudyRenderer::set_plan(const LsPlanOptions& plan) {

@@ -81,9 +81,14 @@ MergedRender merge_partials(const std::vector<std::string>& paths) {
       r.total.assign(size_t(r.width) * r.height, glm::vec3(0.0f));
       owner.assign(grid.count(), -1);
       structures = p.report.value("structures", nlohmann::json::array());
+      m.exposure = exposure_request_from_json(p.report);
     } else {
       const std::string diff = difference(first, p);
       if (!diff.empty()) throw InputError("merge: not partials of one render: " + diff);
+      const ExposureRequest e = exposure_request_from_json(p.report);
+      if (e.automatic != m.exposure.automatic || e.ev != m.exposure.ev)
+        throw InputError("merge: not partials of one render: exposure is " + exposure_request_json(e).dump() + " in " +
+                         p.path + " but " + exposure_request_json(m.exposure).dump() + " in " + paths[0]);
       // Each shard built the structures itself: their build time adds up like the render time.
       const nlohmann::json more = p.report.value("structures", nlohmann::json::array());
       for (nlohmann::json& s : structures)
@@ -122,7 +127,7 @@ MergedRender merge_partials(const std::vector<std::string>& paths) {
   std::string device;
   for (const std::string& d : devices) device += (device.empty() ? "" : "; ") + d;
   const RenderReportContext context{first.header.scene, first.header.schedule, first.header.spp, first.header.seed, nullptr,
-                                    device, nullptr, ThroughputSwitch{}};
+                                    device, nullptr, ThroughputSwitch{}, ExposureRequest{}};
   m.report = render_report(r, context);
   m.report["structures"] = structures;
   m.report["throughput_switch"] = first.report.value("throughput_switch", nlohmann::json(nullptr));

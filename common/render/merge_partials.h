@@ -5,10 +5,11 @@
 //
 // Refused, with a one-line reason (InputError): a file that cannot be read or is not a partial,
 // partials of different renders (the attribute that differs is named: scene fingerprint, schedule,
-// spp, bounces, seed, size, tile size, Line Space flags, throughput switch), a tile in two partials, or
+// spp, bounces, seed, size, tile size, Line Space flags, throughput switch, exposure), a tile in two partials, or
 // tiles in none.
 #pragma once
 
+#include "common/render/exposure.h"
 #include "common/render/render_types.h"
 
 #include <nlohmann/json.hpp>
@@ -24,6 +25,7 @@ struct MergedRender {
   nlohmann::json report;  // the single render's report.json keys (sums; "seconds" is the shards' sum,
                           // not wall time) plus "tile_size" and "shards": file, selection, tiles,
                           // device, threads, seconds and indirect rays/seconds/MRays/s of each
+  ExposureRequest exposure;  // the PNG's, as the shards were asked (render --exposure)
 };
 
 // Reads the partials one at a time (memory: the merged images and one partial).

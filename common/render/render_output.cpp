@@ -105,20 +105,22 @@ void create_output_folder(const std::string& dir) {
   if (ec) throw InputError("cannot create output folder '" + dir + "': " + ec.message());
 }
 
-void write_render_images(const std::string& dir, const RenderResult& result) {
+void write_render_images(const std::string& dir, const RenderResult& result, const Exposure& exposure) {
   create_output_folder(dir);
   const std::filesystem::path out(dir);
   Image image{result.width, result.height, result.total};
   write_exr((out / "total.exr").string(), image);
-  write_png((out / "image.png").string(), image);
+  write_png((out / "image.png").string(), image, exposure.multiplier);
   for (size_t k = 0; k < result.bounce_images.size(); ++k)
     write_exr((out / ("bounce_" + std::to_string(k) + ".exr")).string(),
               Image{result.width, result.height, result.bounce_images[k]});
 }
 
 nlohmann::json write_render_outputs(const std::string& dir, const RenderResult& result, const RenderReportContext& context) {
-  write_render_images(dir, result);
+  const Exposure exposure = choose_exposure(context.exposure, result.total);
+  write_render_images(dir, result, exposure);
   nlohmann::json report = render_report(result, context);
+  report["exposure"] = exposure_json(exposure);
   write_json_file((std::filesystem::path(dir) / "report.json").string(), report);
   return report;
 }

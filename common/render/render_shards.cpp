@@ -48,6 +48,7 @@ std::string write_shard_outputs(const std::string& dir, const ShardChoice& choic
   report["tile_size"] = h.tile_size;
   report["tiles"] = tile_ranges_text(h.tiles);
   report["selection"] = h.selection;
+  report["exposure"] = exposure_request_json(context.exposure);  // the merge exposes the whole image
   create_output_folder(dir);
   const std::filesystem::path stem = std::filesystem::path(dir) / partial_stem(choice.selection);
   const std::string exr = stem.string() + ".exr";
@@ -56,10 +57,14 @@ std::string write_shard_outputs(const std::string& dir, const ShardChoice& choic
   return stem.string();
 }
 
-void merge_render_outputs(const std::string& dir, const std::vector<std::string>& partials) {
+nlohmann::json merge_render_outputs(const std::string& dir, const std::vector<std::string>& partials) {
   const MergedRender m = merge_partials(partials);
-  write_render_images(dir, m.result);
-  write_json_file((std::filesystem::path(dir) / "report.json").string(), m.report);
+  const Exposure exposure = choose_exposure(m.exposure, m.result.total);
+  write_render_images(dir, m.result, exposure);
+  nlohmann::json report = m.report;
+  report["exposure"] = exposure_json(exposure);
+  write_json_file((std::filesystem::path(dir) / "report.json").string(), report);
+  return report;
 }
 
 }  // namespace ls

@@ -33,7 +33,8 @@ std::string write_shard_outputs(const std::string& dir, const ShardChoice& choic
                                 const RenderResult& result, const RenderReportContext& context, const LsBuildOptions& ls,
                                 const LsLookup& lookup);
 
-// `merge`: merges the partials and writes total.exr, bounce_K.exr, image.png and report.json into dir.
-void merge_render_outputs(const std::string& dir, const std::vector<std::string>& partials);
+// `merge`: merges the partials and writes total.exr, bounce_K.exr, image.png (exposed as the shards
+// were asked, from the merged image) and report.json into dir; returns the report.
+nlohmann::json merge_render_outputs(const std::string& dir, const std::vector<std::string>& partials);
 
 }  // namespace ls

@@ -2,12 +2,12 @@
 // and the Line Space flags, so every program spells and checks them the same way.
 #pragma once
 
+#include "common/base/progress.h"
 #include "common/model/scene.h"
 #include "common/structure/accel.h"
 
 #include <CLI/CLI.hpp>
 
-#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -114,10 +114,10 @@ struct LsFlags {
     o.plan.lookup = lookup();  // 2l-ls:auto measures its plan with the lookup the renders use
     o.traversal = parse_traversal(traversal);
     o.exact_width = exact_width;
-    if (progress)
-      o.ls.progress = [](size_t done, size_t total) {
-        std::fprintf(stderr, "\rline space: %zu/%zu LS nodes%s", done, total, done == total ? "\n" : "");
-      };
+    if (progress) {
+      const ProgressLine line("line space", "LS nodes");
+      o.ls.progress = [line](size_t done, size_t total) { line.update(done, total); };
+    }
     return o;
   }
 };

@@ -2,9 +2,11 @@
 
 #include "common/base/interrupt.h"
 #include "common/base/memory_budget.h"
+#include "common/base/progress.h"
 #include "common/base/ray_files.h"
 #include "common/base/thread_limit.h"
 #include "common/render/backend.h"
+#include "common/render/exposure.h"
 #include "common/render/render_output.h"
 #include "common/render/render_shards.h"
 #include "common/render/render_types.h"
@@ -21,7 +23,6 @@
 
 #include <cstdio>
 #include <iostream>
-#include <unistd.h>
 
 namespace ls {
 namespace {
@@ -42,6 +43,7 @@ struct Values {
   std::string schedule = "bvh", size = "512x512", out_dir = "out/render";
   int spp = 16, bounces = 3;
   bool quiet = false;
+  std::string exposure = "auto";  // the PNG's (exposure.h)
   std::string frames, top_level = "rebuild";  // render --frames A:B (render_frames.h)
   double fps = 24.0;
   size_t animation = 0;
@@ -107,6 +109,9 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.render->add_option("--out", v.out_dir, "output folder")->capture_default_str();
   c.render->add_option("--seed", v.seed)->capture_default_str();
   c.render->add_flag("--quiet", v.quiet, "no progress bar");
+  c.render->add_option("--exposure", v.exposure,
+                       "the PNG's exposure: auto (the log-average luminance becomes middle grey) or EV, a multiplier of 2^EV; "
+                       "EXRs stay linear")->capture_default_str();
   CLI::Option* frames = c.render->add_option(
       "--frames", v.frames, "render frames A..B of the scene's animation (A:B or N) into OUT/frame_NNNN/ and OUT/frames.json");
   c.render->add_option("--fps", v.fps, "frames per second: frame f is posed at t = f / fps")->capture_default_str()->needs(frames);
@@ -175,14 +180,8 @@ RenderOptions render_options(const Values& v) {
 }
 
 Progress progress_bar(const Values& v) {
-  const bool show = !v.quiet && isatty(2);
-  return [show](int done, int total) {
-    if (!show) return;
-    const int width = 30, filled = done * width / total;
-    std::fprintf(stderr, "\rrender [%s%s] %d/%d samples", std::string(size_t(filled), '#').c_str(),
-                 std::string(size_t(width - filled), ' ').c_str(), done, total);
-    if (done == total) std::fprintf(stderr, "\n");
-  };
+  const ProgressLine line("render", "samples", !v.quiet && stderr_is_terminal());
+  return [line](int done, int total) { line.update(size_t(done), size_t(total)); };
 }
 
 // render --frames: the animation, frame by frame (render_frames.h).
@@ -194,6 +193,7 @@ void run_render_frames(const Scene& scene, const Values& v, Backend& backend) {
   frames.flat_comparison = !v.no_flat_comparison;
   frames.top_level = parse_top_level_mode(v.top_level);
   frames.quiet = v.quiet;
+  frames.exposure = parse_exposure(v.exposure);
   render_frames(scene, v.scene, render_options(v), v.ls.options(), frames, v.out_dir, backend, progress_bar(v));
 }
 
@@ -219,14 +219,16 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   const Progress progress = progress_bar(v);
   const RenderResult result = backend.render(scene, built, options, progress);
   const std::string device = backend.device();
-  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr, policy};
+  RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr, policy,
+                          parse_exposure(v.exposure)};
   if (shard.sharded()) {
     const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls, options.lookup);
     std::printf("wrote %s.{exr, json} (a partial for merge): %zu of the image's %s\n", stem.c_str(), shard.tiles.size(),
                 shard.grid.describe().c_str());
   } else {
-    write_render_outputs(v.out_dir, result, ctx);
-    std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}\n", v.out_dir.c_str(), options.bounces);
+    const nlohmann::json report = write_render_outputs(v.out_dir, result, ctx);
+    std::printf("wrote %s/{total.exr, bounce_0..%d.exr, image.png, report.json}; PNG exposure %s\n", v.out_dir.c_str(),
+                options.bounces, exposure_text(exposure_from_report(report)).c_str());
   }
   std::printf("%s, %ux%u, %d spp, %d bounces, schedule %s%s%s%s%s: %.2f s; indirect %.2f MRays/s (%llu rays in %.3f s)\n",
               v.scene.c_str(), options.width, options.height, v.spp, options.bounces, options.schedule.name().c_str(),
@@ -264,12 +266,13 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
     std::vector<StructureSpec> specs = parse_schedule(v.schedule).per_bounce;
     if (!v.throughput_switch.empty()) specs.push_back(parse_throughput_switch(v.throughput_switch).structure);
     check_budget_flag(specs, v);
+    parse_exposure(v.exposure);  // a bad value is refused before any work
   }
   if (*c.bench) check_budget_flag(parse_structure_list(v.structures), v);
   if (*c.merge) {  // files only: no scene, no backend (no device) needed
-    merge_render_outputs(v.out_dir, v.partials);
-    std::printf("merged %zu partials into %s/{total.exr, bounce_K.exr, image.png, report.json}\n", v.partials.size(),
-                v.out_dir.c_str());
+    const nlohmann::json report = merge_render_outputs(v.out_dir, v.partials);
+    std::printf("merged %zu partials into %s/{total.exr, bounce_K.exr, image.png, report.json}; PNG exposure %s\n",
+                v.partials.size(), v.out_dir.c_str(), exposure_text(exposure_from_report(report)).c_str());
     return;
   }
   check_ray_budgets(c, v);
@@ -321,7 +324,7 @@ int run_program(int argc, char** argv, const ProgramInfo& info) {
     std::cerr << info.name << ": " << e.what() << " (see --help)\n";
     return 2;
   }
-  v.ls.progress = isatty(2) && !v.quiet;
+  v.ls.progress = stderr_is_terminal() && !v.quiet;
   try {
     run(commands, v, info);
   } catch (const Interrupted& e) {

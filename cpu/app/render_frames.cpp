@@ -271,7 +271,7 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
                  {"indirect_seconds", result.indirect_seconds()},
                  {"indirect_mrays_per_s", result.indirect_mrays_per_s()}};
       RenderReportContext ctx{scene_spec, options.schedule.name(), options.spp, options.seed, &built, device, frame,
-                              options.throughput_switch};
+                              options.throughput_switch, frames.exposure};
       // A whole frame or none: written aside, renamed when complete.
       const fs::path partial = out / (name + ".partial"), final_dir = out / name;
       fs::remove_all(partial);

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "common/render/backend.h"
+#include "common/render/exposure.h"
 #include "common/render/render_types.h"
 #include "common/structure/accel.h"
 #include "common/structure/top_level.h"
@@ -41,6 +42,7 @@ struct FramesOptions {
   bool flat_comparison = true;              // build the flat counterpart of each 2L structure per frame
   TopLevelMode top_level = TopLevelMode::Rebuild;
   bool quiet = false;                       // no per-frame lines on stderr
+  ExposureRequest exposure;                 // each frame's PNG (auto: each frame exposed on its own)
 };
 
 // The flat structure a two-level one is compared with: bvh for 2l-bvh, f-ls:D:N for 2l-ls:D:N, and

@@ -324,11 +324,12 @@ void search_line_space(const LsBuildOptions& options, Accel& accel) {
     });
     empty += pack_ls_candidates(accel, li, prims.data());  // nodes own disjoint words
     const size_t done = ++nodes_done;
-    if (options.progress && progress_mutex.try_lock()) {  // never wait: a busy reporter skips a tick
+    if (options.progress && done < accel.ls_nodes.size() && progress_mutex.try_lock()) {  // never wait: skip a tick
       options.progress(done, accel.ls_nodes.size());
       progress_mutex.unlock();
     }
   });
+  if (options.progress && !accel.ls_nodes.empty()) options.progress(accel.ls_nodes.size(), accel.ls_nodes.size());  // once
   accel.ls_info.empty_shafts = empty.load();
   accel.ls_info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
