@@ -105,6 +105,7 @@ TEST_CASE("a validator study shows its renders' progress on a terminal, and only
   REQUIRE(study.piped.status == 0);
   CHECK(contains(study.terminal.output, "\rrender ["));
   CHECK(contains(study.terminal.output, "samples"));
+  CHECK(contains(study.terminal.output, "\r" + std::string(40, ' ')));  // a finished render's line is erased
   CHECK(!contains(study.piped.err, "\r"));
   CHECK(!contains(study.piped.err, "samples"));
   CHECK(contains(study.piped.err, "reference (bvh)"));  // the study's own log is still there

@@ -44,10 +44,10 @@ void ProgressLine::update(size_t done, size_t total) const {
   if (line.size() > s.width) s.width = line.size();
   std::fprintf(stderr, "\r%s", line.c_str());
   if (last) {  // the next update begins a new line (render --frames: one per frame)
-    s.drawn = false;
-    s.width = 0;
     if (s.end == ProgressEnd::Keep) std::fprintf(stderr, "\n");
     else std::fprintf(stderr, "\r%s\r", std::string(s.width, ' ').c_str());
+    s.drawn = false;
+    s.width = 0;
   }
   std::fflush(stderr);
 }
