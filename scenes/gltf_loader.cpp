@@ -17,6 +17,8 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <new>
 #include <optional>
 #include <set>
@@ -564,13 +566,49 @@ bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& p
 }
 bool no_write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
 
+// Debian's tinygltf reads a GLB's BIN chunk for as many bytes as the chunk says, past the end of the
+// file when it lies (heap overflow, found by fuzzing).  So every chunk's header and data must lie
+// within the file, and within the length its header gives, before tinygltf sees it.  Empty: sound.
+std::string glb_layout_error(const unsigned char* data, size_t size) {
+  const auto u32 = [&](size_t at) {
+    uint32_t v;
+    std::memcpy(&v, data + at, 4);  // little-endian, as x86-64 and the GLB format are
+    return uint64_t(v);
+  };
+  if (size < 12 || std::memcmp(data, "glTF", 4) != 0) return "not a GLB file (no 'glTF' header)";
+  const uint64_t length = u32(8);
+  if (length > size) return "the GLB header's length " + std::to_string(length) + " exceeds the file's " + std::to_string(size) + " bytes";
+  for (uint64_t at = 12; at < length;) {
+    if (at + 8 > length) return "a GLB chunk header runs past the end of the data";
+    const uint64_t chunk = u32(size_t(at));
+    if (at + 8 + chunk > length)
+      return "a GLB chunk of " + std::to_string(chunk) + " bytes at byte " + std::to_string(at) + " runs past the end of the data";
+    at += 8 + chunk;
+  }
+  return "";
+}
+
 }  // namespace
 
 Scene load_gltf(const std::string& path) {
   const bool binary = lower_ext(path) == ".glb";
   return load_gltf_with(path, [&](tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn) {
-    return binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                  : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    if (!binary) return loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    std::ifstream in(path, std::ios::binary);
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) {
+      err = "cannot read the file";
+      return false;
+    }
+    if (bytes.size() > UINT32_MAX) {
+      err = "larger than 4 GiB";
+      return false;
+    }
+    err = glb_layout_error(bytes.data(), bytes.size());
+    if (!err.empty()) return false;
+    // What LoadBinaryFromFile does, on bytes checked first: external files relative to the file's folder.
+    return loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
+                                       std::filesystem::path(path).parent_path().string());
   });
 }
 
@@ -583,8 +621,9 @@ Scene load_gltf_bytes(const std::string& bytes, const std::string& name, bool bi
       err = "larger than 4 GiB";
       return false;
     }
-    return binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), "")
-                  : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), "");
+    if (!binary) return loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), "");
+    err = glb_layout_error(data, bytes.size());
+    return err.empty() && loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), "");
   });
 }
 

@@ -488,6 +488,13 @@ TEST_CASE("bad glTF input is an input error naming the file", "[scenes]") {
     const std::string full = g.glb(R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}])");
     fails("truncated.glb", full.substr(0, full.size() / 2), "truncated .glb");
     fails("short.glb", full.substr(0, 10), "header only");
+    // A BIN chunk longer than what is left, under a header whose length fits the file (tinygltf read
+    // past the end of such a file: a fuzzer's find).
+    std::string lying = full.substr(0, full.size() - 4);
+    const uint32_t length = uint32_t(lying.size());
+    std::memcpy(lying.data() + 8, &length, 4);
+    fails("bin_past_end.glb", lying, "BIN chunk past the end");
+    CHECK_THROWS_WITH(load_scene(dir.write("bin_past_end.glb", lying)), Contains("runs past the end"));
   }
   // Accessors and views that run past their buffer.
   const auto mesh_with = [](const std::string& accessors_views, const std::string& prim) {
