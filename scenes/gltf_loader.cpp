@@ -588,6 +588,17 @@ std::string glb_layout_error(const unsigned char* data, size_t size) {
   return "";
 }
 
+// A GLB in memory, its layout checked first; external files are looked up in base_dir.
+bool load_glb(tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn,
+              const unsigned char* data, size_t size, const std::string& base_dir) {
+  if (size > UINT32_MAX) {
+    err = "larger than 4 GiB";
+    return false;
+  }
+  err = glb_layout_error(data, size);
+  return err.empty() && loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(size), base_dir);
+}
+
 }  // namespace
 
 Scene load_gltf(const std::string& path) {
@@ -600,15 +611,8 @@ Scene load_gltf(const std::string& path) {
       err = "cannot read the file";
       return false;
     }
-    if (bytes.size() > UINT32_MAX) {
-      err = "larger than 4 GiB";
-      return false;
-    }
-    err = glb_layout_error(bytes.data(), bytes.size());
-    if (!err.empty()) return false;
     // What LoadBinaryFromFile does, on bytes checked first: external files relative to the file's folder.
-    return loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
-                                       std::filesystem::path(path).parent_path().string());
+    return load_glb(loader, model, err, warn, bytes.data(), bytes.size(), std::filesystem::path(path).parent_path().string());
   });
 }
 
@@ -616,14 +620,12 @@ Scene load_gltf_bytes(const std::string& bytes, const std::string& name, bool bi
   return load_gltf_with(name, [&](tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& err, std::string& warn) {
     tinygltf::FsCallbacks fs{&no_file_exists, &no_expand, &no_read, &no_write, nullptr};
     loader.SetFsCallbacks(fs);
-    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
     if (bytes.size() > UINT32_MAX) {
       err = "larger than 4 GiB";
       return false;
     }
     if (!binary) return loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), "");
-    err = glb_layout_error(data, bytes.size());
-    return err.empty() && loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), "");
+    return load_glb(loader, model, err, warn, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), "");
   });
 }
 
