@@ -261,8 +261,8 @@ void layout_line_space_nodes(const LsBuildOptions& options, const Limits& limits
     subdivisions.insert(p.ls.n);
   }
   accel.ls_candidates.clear();
-  resize_huge(accel.ls_candidates, words);  // read at random by lookups, like the records
-  std::fill(accel.ls_candidates.begin(), accel.ls_candidates.end(), 0xFFFFFFFFu);  // all ones: every shaft empty until found
+  reserve_huge(accel.ls_candidates, words);  // read at random by lookups, like the records
+  accel.ls_candidates.assign(words, 0xFFFFFFFFu);  // all ones: every shaft empty until found
   info.ls_nodes = accel.ls_nodes.size();
   info.shafts_per_ls = subdivisions.size() == 1 ? lsk::ls_shaft_count(*subdivisions.begin())
                        : subdivisions.empty() && accel.spec.subdivision > 0 ? lsk::ls_shaft_count(uint32_t(accel.spec.subdivision))
