@@ -115,26 +115,12 @@ LS_FN void ls_window(IN(vec3) origin, IN(vec3) inv_dir, IN(vec3) box_lo, IN(vec3
   window_hi = min(hi, tmax);
 }
 
-// One lookup at an LS node whose BVH box is [box_lo, box_hi], for a ray launched with [tmin, tmax]:
-// LS_ACCEPTED (its plane hit offered to the running hit), LS_EMPTY (skip the subtree) or
-// LS_FALLBACK (traverse the subtree exactly).
-LS_FN uint ls_lookup(uint ls_index, IN(vec3) box_lo, IN(vec3) box_hi, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir,
-                     float tmin, float tmax, uint instance, INOUT(Hit) hit, INOUT(uint) hit_prim) {
-  LsNode ls = ls_nodes[ls_index];
+// ls_lookup once the ray's line is known to cross shaft `shaft` of `ls`, entering and leaving the
+// LS box at t_in and t_out (ls_line_shaft): what a caller that loaded the shaft ahead of time runs.
+LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, float t_in, float t_out, IN(vec3) box_lo, IN(vec3) box_hi,
+                           IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, float tmin, float tmax, uint instance,
+                           INOUT(Hit) hit, INOUT(uint) hit_prim) {
   ls_counters.lookups += 1u;
-  // A refusal angle of 0 refuses every approximation, the "no hit" of an empty shaft included, so
-  // the structure answers exactly like its BVH.
-  if (ls_cos2 < 0.0f) {
-    ls_counters.refused_angle += 1u;
-    return LS_FALLBACK;
-  }
-  uint shaft;
-  float t_in;
-  float t_out;
-  if (!ls_line_shaft(origin, dir, inv_dir, ls.lo, ls.hi, ls.scale, ls.n, shaft, t_in, t_out)) {
-    ls_counters.refused_no_shaft += 1u;
-    return LS_FALLBACK;
-  }
   uint prim = ls_candidate(ls, shaft);
   if (prim == LS_INVALID) {
     ls_counters.empty += 1u;
@@ -183,4 +169,28 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) box_lo, IN(vec3) box_hi, IN(vec3) o
   if (t <= hit.t && offer_hit(t, u, v, inst, ls_records[prim].id, hit)) hit_prim = prim;
   ls_counters.accepted += 1u;
   return LS_ACCEPTED;
+}
+
+// One lookup at an LS node whose BVH box is [box_lo, box_hi], for a ray launched with [tmin, tmax]:
+// LS_ACCEPTED (its plane hit offered to the running hit), LS_EMPTY (skip the subtree) or
+// LS_FALLBACK (traverse the subtree exactly).
+LS_FN uint ls_lookup(uint ls_index, IN(vec3) box_lo, IN(vec3) box_hi, IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir,
+                     float tmin, float tmax, uint instance, INOUT(Hit) hit, INOUT(uint) hit_prim) {
+  LsNode ls = ls_nodes[ls_index];
+  // A refusal angle of 0 refuses every approximation, the "no hit" of an empty shaft included, so
+  // the structure answers exactly like its BVH.
+  if (ls_cos2 < 0.0f) {
+    ls_counters.lookups += 1u;
+    ls_counters.refused_angle += 1u;
+    return LS_FALLBACK;
+  }
+  uint shaft;
+  float t_in;
+  float t_out;
+  if (!ls_line_shaft(origin, dir, inv_dir, ls.lo, ls.hi, ls.scale, ls.n, shaft, t_in, t_out)) {
+    ls_counters.lookups += 1u;
+    ls_counters.refused_no_shaft += 1u;
+    return LS_FALLBACK;
+  }
+  return ls_shaft_lookup(ls, shaft, t_in, t_out, box_lo, box_hi, origin, dir, inv_dir, tmin, tmax, instance, hit, hit_prim);
 }
