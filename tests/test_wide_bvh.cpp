@@ -214,6 +214,47 @@ TEST_CASE("wide BVH: same answers with --ls-behind reverse, in either walk order
   }
 }
 
+TEST_CASE("wide BVH: rays traced in flight get the hits and counters each gets alone", "[wide]") {
+  // A flat Line Space walks several rays in turn, parking each at its lookups; every ray must end
+  // as it does when it is the only one in the call, counters included.
+  for (const char* scene_name : {"builtin:cornell", "builtin:generated:30000:12:5"}) {
+    const ls::Scene scene = ls::load_scene(scene_name);
+    const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));
+    for (const char* kind : {"diffuse", "random", "shadow"}) {
+      const std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::parse_ray_kind(kind), 2000, 13);
+      for (const char* s : {"f-ls:4:4", "f-ls:8:6"})
+        for (bool reverse : {false, true})
+          for (bool occlusion : {false, true}) {
+            const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(8));
+            ls::LsLookup lookup;
+            lookup.reverse_behind = reverse;
+            INFO(scene_name << ", " << kind << " rays, " << s << (reverse ? ", reverse" : "") << (occlusion ? ", occlusion" : ""));
+            auto trace = [&](lsk::TraceContext& c, const lsk::Ray* r, lsk::Hit* h, size_t n) {
+              if (occlusion)
+                a.fast->occluded(c, r, h, n);
+              else
+                a.fast->trace(c, r, h, n, false);
+            };
+            std::vector<lsk::Hit> together(rays.size()), alone(rays.size());
+            lsk::TraceContext c_together = ls::trace_context(a, lookup);
+            trace(c_together, rays.data(), together.data(), rays.size());
+            lsk::TraceContext c_alone = ls::trace_context(a, lookup);
+            for (size_t i = 0; i < rays.size(); ++i) trace(c_alone, &rays[i], &alone[i], 1);
+            size_t mismatches = 0, hits = 0;
+            for (size_t i = 0; i < rays.size(); ++i) {
+              mismatches += std::memcmp(&together[i], &alone[i], sizeof(lsk::Hit)) != 0;
+              hits += alone[i].triangle != lsk::LS_INVALID;
+            }
+            CHECK(mismatches == 0);
+            CHECK(hits > 0);
+            INFO("together: " << describe(c_together.ls_counters) << "\nalone:    " << describe(c_alone.ls_counters));
+            CHECK(c_alone.ls_counters.accepted > 0);
+            CHECK(std::memcmp(&c_together.ls_counters, &c_alone.ls_counters, sizeof(lsk::LsCounters)) == 0);
+          }
+    }
+  }
+}
+
 TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degenerate rays", "[wide]") {
   const ls::Scene scene = random_scene(4);
   StdRng rng(99);

@@ -13,6 +13,7 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <memory>
 #include <type_traits>
 
@@ -343,6 +344,8 @@ class WideTracer final : public FastTracer {
   enum class Query { Closest, AnyHit, Occlusion };
 
   void trace_all(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query q) const {
+    if constexpr (kLs)
+      if (!two_level_ && q != Query::AnyHit && c.ls_enabled != 0u) return trace_in_flight(c, rays, hits, count, q);
     for (size_t i = 0; i < count; ++i) {
       const lsk::Ray& ray = rays[i];
       // A flat structure's trace_bvh makes this choice itself; the top walk of a two-level one does not.
@@ -420,16 +423,145 @@ class WideTracer final : public FastTracer {
   __attribute__((noinline)) bool ls_node(lsk::TraceContext& c, uint b, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
     const lsk::BvhNode& node = c.nodes[b];
     const uint ls = q.use_ls ? c.node_ls[b] : LS_INVALID;
-    if (ls != LS_INVALID) {
-      const uint answer =
-          c.ls_lookup(ls, node.lo, node.hi, q.origin, q.dir, q.inv_dir, q.tmin, q.tmax, q.instance, hit, hit_prim);
-      if (answer == lsk::TraceContext::LS_ACCEPTED) return q.any_hit && hit.triangle != LS_INVALID;
-      if (answer == lsk::TraceContext::LS_EMPTY) return false;
-    }
+    const uint answer = ls == LS_INVALID ? lsk::TraceContext::LS_FALLBACK
+                                         : c.ls_lookup(ls, node.lo, node.hi, q.origin, q.dir, q.inv_dir, q.tmin, q.tmax,
+                                                       q.instance, hit, hit_prim);
+    return answered(c, b, answer, q, hit, hit_prim);
+  }
+
+  // What a lookup's answer at binary node b asks: nothing more (accepted, empty), or the subtree's
+  // exact walk (refused).  True: an occlusion query's hit.
+  LS_ALWAYS_INLINE bool answered(lsk::TraceContext& c, uint b, uint answer, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
+    if (answer == lsk::TraceContext::LS_ACCEPTED) return q.any_hit && hit.triangle != LS_INVALID;
+    if (answer == lsk::TraceContext::LS_EMPTY) return false;
+    return walk_refused(c, b, q, hit, hit_prim);
+  }
+
+  __attribute__((noinline)) bool walk_refused(lsk::TraceContext& c, uint b, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
+    const lsk::BvhNode& node = c.nodes[b];
     if (node.count > 0)
       return trace_blocks(c, blocks_, part_->blocks.lane_of[b], node.count, q.tri_ray(), q.tmin, q.instance, q.any_hit, hit,
                           hit_prim);
     return run_exact(c, part_->exact.entry_of[b], q, hit, hit_prim);
+  }
+
+  // Rays in flight (flat Line Space, closest hit and occlusion): a lookup waits on two dependent
+  // cache misses, the shaft's candidate word and then the candidate's record, and a ray makes
+  // about one lookup, so one ray alone has nothing to overlap them with.  kInFlight rays walk in
+  // turn instead: a walk that reaches a Line Space lane computes its shaft, starts loading the word
+  // and parks; on its next turn it reads the word and starts loading the record; on the turn after
+  // it runs the lookup on loaded lines and walks on.  The answers are order-free, so every ray gets
+  // the hit (and the counters) it gets alone.
+  static constexpr int kInFlight = 8;
+  enum class Phase { Free, Word, Record };
+  struct Flight {
+    Phase phase = Phase::Free;
+    size_t ray = 0;
+    std::optional<ObjectQuery> q;
+    Hit hit;
+    uint prim = LS_INVALID;
+    ExactWalk<W> walk;
+    uint ls = LS_INVALID;  // the Line Space node it is parked at (walk.child is its binary node)
+    uint shaft = 0;
+    float t_in = 0.0f;
+    float t_out = 0.0f;
+  };
+
+  void trace_in_flight(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query query) const {
+    const uint entry = part_->exact.entry_of[0];
+    const bool flat_walk = entry != LS_INVALID && c.node_ls[0] == LS_INVALID;  // trace_bvh's usual case
+    Flight flights[kInFlight];
+    size_t next = 0;
+    // Starts the next ray that parks in f; the rays before it that finish without parking (or that
+    // the walk does not take) are traced here.  f is free when the rays run out.
+    auto launch = [&](Flight& f) {
+      f.phase = Phase::Free;
+      while (next < count) {
+        const size_t i = next++;
+        const lsk::Ray& ray = rays[i];
+        if (!flat_walk || !order_free_ray(ray.origin, ray.dir, ray.tmin) || ray.tmax != ray.tmax) {
+          hits[i] = trace_flat(c, ray, query);
+          continue;
+        }
+        f.ray = i;
+        f.hit = lsk::empty_hit(ray);
+        f.prim = LS_INVALID;
+        f.q.emplace(ray.origin, ray.dir, lsk::safe_reciprocal(ray.dir), ray.tmin, ray.tmax, LS_INVALID,
+                    query != Query::Closest, true);
+        f.walk.start(entry);
+        if (fly(c, f)) return;
+        hits[i] = lsk::finish_hit(f.hit);
+      }
+    };
+    int live = 0;
+    for (Flight& f : flights) {
+      launch(f);
+      live += f.phase != Phase::Free;
+    }
+    while (live > 0) {
+      for (Flight& f : flights) {
+        if (f.phase == Phase::Word) {
+          const uint prim = c.ls_candidate(c.ls_nodes[f.ls], f.shaft);
+          if (prim != LS_INVALID) __builtin_prefetch(&c.ls_records[prim]);
+          f.phase = Phase::Record;
+        } else if (f.phase == Phase::Record) {
+          if (land(c, f)) continue;
+          hits[f.ray] = lsk::finish_hit(f.hit);
+          launch(f);
+          live -= f.phase == Phase::Free;
+        }
+      }
+    }
+  }
+
+  // Walks f's ray on until it parks at a Line Space lane (true) or its walk is over (false).
+  bool fly(lsk::TraceContext& c, Flight& f) const {
+    ObjectQuery& q = *f.q;
+    const BlockRay& tr = q.tri_ray();
+    const ExactBatch<W> tmin_batch(q.tmin);
+    auto leaf = [&](uint child, uint n) LS_ALWAYS_LAMBDA {
+      return trace_blocks(c, blocks_, child, n, tr, q.tmin, q.instance, q.any_hit, f.hit, f.prim);
+    };
+    auto prefetch = [&](uint child, uint n) LS_ALWAYS_LAMBDA {
+      if (n != kLsLane) prefetch_block(child / 4u);
+    };
+    for (;;) {
+      if (f.walk.count == kLsLane) {  // a Line Space lane: park, or answer it here
+        if (park(c, f)) return true;
+        if (ls_node(c, f.walk.child, q, f.hit, f.prim) || !f.walk.pop(f.hit.t)) return false;
+        continue;
+      }
+      const bool more = q.exact_ray.any_parallel
+                            ? f.walk.template step<true>(part_->exact, q.exact_ray, tmin_batch, f.hit, leaf, prefetch)
+                            : f.walk.template step<false>(part_->exact, q.exact_ray, tmin_batch, f.hit, leaf, prefetch);
+      if (!more) return false;
+    }
+  }
+
+  // Parks f at the Line Space lane its walk reached: its shaft, and the candidate word loading.
+  // False where the lookup has no shaft to load (ls_lookup answers it at once).
+  bool park(const lsk::TraceContext& c, Flight& f) const {
+    const uint ls = c.node_ls[f.walk.child];
+    if (ls == LS_INVALID || c.ls_cos2 < 0.0f) return false;
+    const lsk::LsNode& node = c.ls_nodes[ls];
+    const ObjectQuery& q = *f.q;
+    if (!lsk::ls_line_shaft(q.origin, q.dir, q.inv_dir, node.lo, node.hi, node.scale, node.n, f.shaft, f.t_in, f.t_out))
+      return false;
+    __builtin_prefetch(&c.ls_candidates[node.candidates + f.shaft / (4u / node.bytes)]);
+    f.ls = ls;
+    f.phase = Phase::Word;
+    return true;
+  }
+
+  // f's lookup on its loaded lines, then its walk on: true when it parks again.
+  bool land(lsk::TraceContext& c, Flight& f) const {
+    ObjectQuery& q = *f.q;
+    const uint b = f.walk.child;
+    const lsk::BvhNode& node = c.nodes[b];
+    const uint answer = c.ls_shaft_lookup(c.ls_nodes[f.ls], f.shaft, f.t_in, f.t_out, node.lo, node.hi, q.origin, q.dir,
+                                          q.inv_dir, q.tmin, q.tmax, q.instance, f.hit, f.prim);
+    if (answered(c, b, answer, q, f.hit, f.prim) || !f.walk.pop(f.hit.t)) return false;
+    return fly(c, f);
   }
 
   // lsk::TraceContext::trace_bvh on the wide trees: the order-free walk, except for the reference's
