@@ -463,6 +463,7 @@ class WideTracer final : public FastTracer {
     ExactWalk<W> walk;
     uint ls = LS_INVALID;  // the Line Space node it is parked at (walk.child is its binary node)
     uint shaft = 0;
+    uint reverse_shaft = 0;  // --ls-behind reverse: loaded too, in case the first candidate's plane hit is behind
     float t_in = 0.0f;
     float t_out = 0.0f;
   };
@@ -501,8 +502,13 @@ class WideTracer final : public FastTracer {
     while (live > 0) {
       for (Flight& f : flights) {
         if (f.phase == Phase::Word) {
-          const uint prim = c.ls_candidate(c.ls_nodes[f.ls], f.shaft);
+          const lsk::LsNode& node = c.ls_nodes[f.ls];
+          const uint prim = c.ls_candidate(node, f.shaft);
           if (prim != LS_INVALID) __builtin_prefetch(&c.ls_records[prim]);
+          if (c.ls_reverse != 0u) {
+            const uint reverse_prim = c.ls_candidate(node, f.reverse_shaft);
+            if (reverse_prim != LS_INVALID) __builtin_prefetch(&c.ls_records[reverse_prim]);
+          }
           f.phase = Phase::Record;
         } else if (f.phase == Phase::Record) {
           if (land(c, f)) continue;
@@ -548,6 +554,13 @@ class WideTracer final : public FastTracer {
     if (!lsk::ls_line_shaft(q.origin, q.dir, q.inv_dir, node.lo, node.hi, node.scale, node.n, f.shaft, f.t_in, f.t_out))
       return false;
     __builtin_prefetch(&c.ls_candidates[node.candidates + f.shaft / (4u / node.bytes)]);
+    if (c.ls_reverse != 0u) {  // the reverse shaft's candidate answers when the first's plane hit is behind tmin
+      uint start_patch;
+      uint end_patch;
+      lsk::ls_shaft_patches(f.shaft, node.n, start_patch, end_patch);
+      f.reverse_shaft = lsk::ls_shaft_index(end_patch, start_patch, node.n);
+      __builtin_prefetch(&c.ls_candidates[node.candidates + f.reverse_shaft / (4u / node.bytes)]);
+    }
     f.ls = ls;
     f.phase = Phase::Word;
     return true;
