@@ -215,14 +215,14 @@ TEST_CASE("wide BVH: same answers with --ls-behind reverse, in either walk order
 }
 
 TEST_CASE("wide BVH: rays traced in flight get the hits and counters each gets alone", "[wide]") {
-  // A flat Line Space walks several rays in turn, parking each at its lookups; every ray must end
-  // as it does when it is the only one in the call, counters included.
-  for (const char* scene_name : {"builtin:cornell", "builtin:generated:30000:12:5"}) {
-    const ls::Scene scene = ls::load_scene(scene_name);
+  // A Line Space structure walks several rays in turn, parking each at its lookups; every ray must
+  // end as it does when it is the only one in the call, counters included.
+  for (const char* scene_name : {"builtin:cornell", "builtin:generated:30000:12:5", "random"}) {
+    const ls::Scene scene = std::string(scene_name) == "random" ? random_scene(6) : ls::load_scene(scene_name);
     const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));
     for (const char* kind : {"diffuse", "random", "shadow"}) {
-      const std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::parse_ray_kind(kind), 2000, 13);
-      for (const char* s : {"f-ls:4:4", "f-ls:8:6"})
+      const std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::parse_ray_kind(kind), 1500, 13);
+      for (const char* s : {"f-ls:4:4", "f-ls:8:6", "2l-ls:2:4", "2l-ls:0:6"})
         for (bool reverse : {false, true})
           for (bool occlusion : {false, true}) {
             const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(8));

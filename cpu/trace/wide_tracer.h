@@ -345,7 +345,7 @@ class WideTracer final : public FastTracer {
 
   void trace_all(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query q) const {
     if constexpr (kLs)
-      if (!two_level_ && q != Query::AnyHit && c.ls_enabled != 0u) return trace_in_flight(c, rays, hits, count, q);
+      if (q != Query::AnyHit && c.ls_enabled != 0u) return trace_in_flight(c, rays, hits, count, q);
     for (size_t i = 0; i < count; ++i) {
       const lsk::Ray& ray = rays[i];
       // A flat structure's trace_bvh makes this choice itself; the top walk of a two-level one does not.
@@ -445,28 +445,43 @@ class WideTracer final : public FastTracer {
     return run_exact(c, part_->exact.entry_of[b], q, hit, hit_prim);
   }
 
-  // Rays in flight (flat Line Space, closest hit and occlusion): a lookup waits on two dependent
-  // cache misses, the shaft's candidate word and then the candidate's record, and a ray makes
-  // about one lookup, so one ray alone has nothing to overlap them with.  kInFlight rays walk in
-  // turn instead: a walk that reaches a Line Space lane computes its shaft, starts loading the word
-  // and parks; on its next turn it reads the word and starts loading the record; on the turn after
-  // it runs the lookup on loaded lines and walks on.  The answers are order-free, so every ray gets
-  // the hit (and the counters) it gets alone.
+  // Rays in flight (Line Space structures, closest hit and occlusion): a lookup waits on two
+  // dependent cache misses, the shaft's candidate word and then the candidate's record, and a ray
+  // makes about one lookup, so one ray alone has nothing to overlap them with.  kInFlight rays walk
+  // in turn instead: a walk that reaches a Line Space lane computes its shaft, starts loading the
+  // word and parks; on its next turn it reads the word and starts loading the record; on the turn
+  // after it runs the lookup on loaded lines and walks on.  The answers are order-free, so every
+  // ray gets the hit (and the counters) it gets alone.
   static constexpr int kInFlight = 8;
   enum class Phase { Free, Word, Record };
   struct Flight {
     Phase phase = Phase::Free;
-    size_t ray = 0;
-    std::optional<ObjectQuery> q;
+    size_t index = 0;  // of the ray in the call
+    const lsk::Ray* ray = nullptr;
     Hit hit;
     uint prim = LS_INVALID;
+    // The object walk: the flat BVH's, or the current instance's (two-level).
+    std::optional<ObjectQuery> q;
     ExactWalk<W> walk;
-    uint ls = LS_INVALID;  // the Line Space node it is parked at (walk.child is its binary node)
+    bool in_object = false;
+    // The two-level top walk, and the instances of the leaf it is at: [next_instance, end_instance).
+    ExactWalk<W> top;
+    ExactBoxRay<W> top_ray;
+    bool top_over = false;    // no top walk (its root is a leaf) or its walk has ended
+    bool at_top_leaf = false;  // the instances of top's leaf have been started
+    bool any_hit = false;
+    uint next_instance = 0;
+    uint end_instance = 0;
+    vec3 object_origin;  // the current instance's ray: what q refers to
+    vec3 object_dir;
+    // The lookup it is parked at (walk.child is its binary node).
+    uint ls = LS_INVALID;
     uint shaft = 0;
     uint reverse_shaft = 0;  // --ls-behind reverse: loaded too, in case the first candidate's plane hit is behind
     float t_in = 0.0f;
     float t_out = 0.0f;
   };
+  enum class Flown { Parked, Over, Stopped };  // an object walk's turn: parked, ended, or ended the query
 
   void trace_in_flight(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query query) const {
     const uint entry = part_->exact.entry_of[0];
@@ -474,23 +489,21 @@ class WideTracer final : public FastTracer {
     Flight flights[kInFlight];
     size_t next = 0;
     // Starts the next ray that parks in f; the rays before it that finish without parking (or that
-    // the walk does not take) are traced here.  f is free when the rays run out.
+    // no flight takes) are traced here.  f is free when the rays run out.
     auto launch = [&](Flight& f) {
       f.phase = Phase::Free;
       while (next < count) {
         const size_t i = next++;
         const lsk::Ray& ray = rays[i];
-        if (!flat_walk || !order_free_ray(ray.origin, ray.dir, ray.tmin) || ray.tmax != ray.tmax) {
-          hits[i] = trace_flat(c, ray, query);
+        if (!order_free_ray(ray.origin, ray.dir, ray.tmin) || ray.tmax != ray.tmax || (!two_level_ && !flat_walk)) {
+          hits[i] = two_level_ ? trace_ray_reference(c, ray, true, query != Query::Closest) : trace_flat(c, ray, query);
           continue;
         }
-        f.ray = i;
+        f.index = i;
+        f.ray = &ray;
         f.hit = lsk::empty_hit(ray);
         f.prim = LS_INVALID;
-        f.q.emplace(ray.origin, ray.dir, lsk::safe_reciprocal(ray.dir), ray.tmin, ray.tmax, LS_INVALID,
-                    query != Query::Closest, true);
-        f.walk.start(entry);
-        if (fly(c, f)) return;
+        if (two_level_ ? take_off_two_level(c, f, query) : take_off_flat(c, f, query, entry)) return;
         hits[i] = lsk::finish_hit(f.hit);
       }
     };
@@ -512,7 +525,7 @@ class WideTracer final : public FastTracer {
           f.phase = Phase::Record;
         } else if (f.phase == Phase::Record) {
           if (land(c, f)) continue;
-          hits[f.ray] = lsk::finish_hit(f.hit);
+          hits[f.index] = lsk::finish_hit(f.hit);
           launch(f);
           live -= f.phase == Phase::Free;
         }
@@ -520,34 +533,116 @@ class WideTracer final : public FastTracer {
     }
   }
 
-  // Walks f's ray on until it parks at a Line Space lane (true) or its walk is over (false).
+  // The first turn of a flat structure's ray: true when it parks.
+  bool take_off_flat(lsk::TraceContext& c, Flight& f, Query query, uint entry) const {
+    const lsk::Ray& ray = *f.ray;
+    f.q.emplace(ray.origin, ray.dir, lsk::safe_reciprocal(ray.dir), ray.tmin, ray.tmax, LS_INVALID, query != Query::Closest,
+                true);
+    f.walk.start(entry);
+    return fly_object(c, f) == Flown::Parked;
+  }
+
+  // The first turn of a two-level structure's ray (trace_two_level's set-up): true when it parks.
+  bool take_off_two_level(lsk::TraceContext& c, Flight& f, Query query) const {
+    const lsk::Ray& ray = *f.ray;
+    const vec3 inv_dir = lsk::safe_reciprocal(ray.dir);
+    float t_root;
+    if (!lsk::ray_box(ray.origin, inv_dir, ray.tmin, f.hit.t, c.top_nodes[0].lo, c.top_nodes[0].hi, t_root)) return false;
+    f.any_hit = query != Query::Closest;
+    f.in_object = false;
+    f.at_top_leaf = false;
+    const lsk::BvhNode& root = c.top_nodes[0];
+    f.top_over = root.count > 0;
+    if (f.top_over) {
+      f.next_instance = root.first;
+      f.end_instance = root.first + root.count;
+    } else {
+      f.next_instance = f.end_instance = 0;
+      init_slab_ray<ExactBatch<W>, ExactWideNode<W>>(f.top_ray, ray.origin, inv_dir);
+      f.top.start(top_exact_.entry_of[0]);
+    }
+    return fly(c, f);
+  }
+
+  // f's ray walks on until it parks at a Line Space lane (true) or its query is over (false).
   bool fly(lsk::TraceContext& c, Flight& f) const {
+    if (!two_level_) return fly_object(c, f) == Flown::Parked;
+    const lsk::Ray& ray = *f.ray;
+    const bool use_ls = c.ls_enabled != 0u;
+    for (;;) {
+      if (f.in_object) {
+        const Flown flown = fly_object(c, f);
+        if (flown == Flown::Parked) return true;
+        f.in_object = false;
+        if (flown == Flown::Stopped) return false;
+      }
+      if (f.next_instance < f.end_instance) {  // the next instance of the leaf: trace_bvh's cases
+        const lsk::InstanceRecord& rec = c.instances[f.next_instance++];
+        c.instance_ray(rec, ray.origin, ray.dir, f.object_origin, f.object_dir);
+        const uint root_entry = part_->exact.entry_of[rec.root];
+        if (root_entry != LS_INVALID && c.node_ls[rec.root] == LS_INVALID &&
+            order_free_ray(f.object_origin, f.object_dir, ray.tmin)) {
+          f.q.emplace(f.object_origin, f.object_dir, lsk::safe_reciprocal(f.object_dir), ray.tmin, ray.tmax, rec.instance,
+                      f.any_hit, use_ls);
+          f.walk.start(root_entry);
+          f.in_object = true;
+        } else if (trace_bvh(c, rec.root, f.object_origin, f.object_dir, ray.tmin, ray.tmax, rec.instance,
+                             f.any_hit ? Query::Occlusion : Query::Closest, use_ls, f.hit, f.prim)) {
+          return false;
+        }
+        continue;
+      }
+      if (f.top_over) return false;
+      if (f.top.count != 0u) {  // at a leaf of the instance tree: its instances, then the walk on
+        if (!f.at_top_leaf) {
+          f.next_instance = f.top.child;
+          f.end_instance = f.top.child + f.top.count;
+          f.at_top_leaf = true;
+          continue;
+        }
+        f.at_top_leaf = false;
+        if (!f.top.pop(f.hit.t)) return false;
+        continue;
+      }
+      const ExactBatch<W> tmin_batch(ray.tmin);
+      auto none = [](uint, uint) LS_ALWAYS_LAMBDA { return false; };  // never called: leaves are taken above
+      auto no_prefetch = [](uint, uint) LS_ALWAYS_LAMBDA {};
+      const bool more = f.top_ray.any_parallel
+                            ? f.top.template step<true>(top_exact_, f.top_ray, tmin_batch, f.hit, none, no_prefetch)
+                            : f.top.template step<false>(top_exact_, f.top_ray, tmin_batch, f.hit, none, no_prefetch);
+      if (!more) return false;
+    }
+  }
+
+  // The object walk (flat BVH or an instance's) on until it parks, ends, or ends the query.
+  Flown fly_object(lsk::TraceContext& c, Flight& f) const {
     ObjectQuery& q = *f.q;
-    const BlockRay& tr = q.tri_ray();
-    const ExactBatch<W> tmin_batch(q.tmin);
+    bool stopped = false;
     auto leaf = [&](uint child, uint n) LS_ALWAYS_LAMBDA {
-      return trace_blocks(c, blocks_, child, n, tr, q.tmin, q.instance, q.any_hit, f.hit, f.prim);
+      return stopped = trace_blocks(c, blocks_, child, n, q.tri_ray(), q.tmin, q.instance, q.any_hit, f.hit, f.prim);
     };
     auto prefetch = [&](uint child, uint n) LS_ALWAYS_LAMBDA {
       if (n != kLsLane) prefetch_block(child / 4u);
     };
+    const ExactBatch<W> tmin_batch(q.tmin);
     for (;;) {
       if (f.walk.count == kLsLane) {  // a Line Space lane: park, or answer it here
-        if (park(c, f)) return true;
-        if (ls_node(c, f.walk.child, q, f.hit, f.prim) || !f.walk.pop(f.hit.t)) return false;
+        if (park(c, f)) return Flown::Parked;
+        if (ls_node(c, f.walk.child, q, f.hit, f.prim)) return Flown::Stopped;
+        if (!f.walk.pop(f.hit.t)) return Flown::Over;
         continue;
       }
       const bool more = q.exact_ray.any_parallel
                             ? f.walk.template step<true>(part_->exact, q.exact_ray, tmin_batch, f.hit, leaf, prefetch)
                             : f.walk.template step<false>(part_->exact, q.exact_ray, tmin_batch, f.hit, leaf, prefetch);
-      if (!more) return false;
+      if (!more) return stopped ? Flown::Stopped : Flown::Over;
     }
   }
 
   // Parks f at the Line Space lane its walk reached: its shaft, and the candidate word loading.
   // False where the lookup has no shaft to load (ls_lookup answers it at once).
   bool park(const lsk::TraceContext& c, Flight& f) const {
-    const uint ls = c.node_ls[f.walk.child];
+    const uint ls = f.q->use_ls ? c.node_ls[f.walk.child] : LS_INVALID;
     if (ls == LS_INVALID || c.ls_cos2 < 0.0f) return false;
     const lsk::LsNode& node = c.ls_nodes[ls];
     const ObjectQuery& q = *f.q;
@@ -573,7 +668,11 @@ class WideTracer final : public FastTracer {
     const lsk::BvhNode& node = c.nodes[b];
     const uint answer = c.ls_shaft_lookup(c.ls_nodes[f.ls], f.shaft, f.t_in, f.t_out, node.lo, node.hi, q.origin, q.dir,
                                           q.inv_dir, q.tmin, q.tmax, q.instance, f.hit, f.prim);
-    if (answered(c, b, answer, q, f.hit, f.prim) || !f.walk.pop(f.hit.t)) return false;
+    if (answered(c, b, answer, q, f.hit, f.prim)) return false;  // an occlusion query's hit
+    if (!f.walk.pop(f.hit.t)) {
+      if (!two_level_) return false;
+      f.in_object = false;  // the instance's walk is over: the top walk goes on
+    }
     return fly(c, f);
   }
 
