@@ -75,8 +75,10 @@ LS_FN uint ls_patch_of_point(IN(vec3) p, IN(vec3) lo, IN(vec3) scale, uint face,
   uint ua = a == 2u ? 0u : a + 1u;  // the face's other two axes in cyclic order
   uint va = a == 0u ? 2u : a - 1u;
   int last = int(n) - 1;
-  int i = clamp(int(floor((p[ua] - lo[ua]) * scale[ua])), 0, last);
-  int j = clamp(int(floor((p[va] - lo[va]) * scale[va])), 0, last);
+  // int() truncates toward zero where floor() would round down, which differs only on (-1, 0),
+  // where both clamp to 0: the same patch without the floor (a dozen instructions on SSE2).
+  int i = clamp(int((p[ua] - lo[ua]) * scale[ua]), 0, last);
+  int j = clamp(int((p[va] - lo[va]) * scale[va]), 0, last);
   return ls_patch_index(face, uint(i), uint(j), n);
 }
 

@@ -48,17 +48,21 @@ LS_FN vec3 ls_decode_normal(uint packed) {
   return normalize(v);
 }
 
-// The candidate of a shaft as an index into tris[], or LS_INVALID for an empty shaft.
+// A word of ls_candidates[] holds 4 / bytes candidates (bytes = 1, 2 or 4): log2 of that count.
+LS_FN uint ls_per_word_log2(IN(LsNode) ls) { return 2u - (ls.bytes >> 1u); }
+
+// The word of ls_candidates[] that holds a shaft's candidate.
+LS_FN uint ls_candidate_word(IN(LsNode) ls, uint shaft) { return ls.candidates + (shaft >> ls_per_word_log2(ls)); }
+
+// The candidate of a shaft as an index into tris[], or LS_INVALID for an empty shaft (shifts, not
+// divisions).
 LS_FN uint ls_candidate(IN(LsNode) ls, uint shaft) {
-  if (ls.bytes == 4u) {
-    uint v = ls_candidates[ls.candidates + shaft];
-    return v == LS_INVALID ? LS_INVALID : ls.range_first + v;
-  }
-  uint per_word = 4u / ls.bytes;
-  uint word = ls_candidates[ls.candidates + shaft / per_word];
+  uint per_word_log2 = ls_per_word_log2(ls);
+  uint word = ls_candidates[ls_candidate_word(ls, shaft)];
+  if (ls.bytes == 4u) return word == LS_INVALID ? LS_INVALID : ls.range_first + word;
   uint bits = ls.bytes * 8u;
   uint mask = (1u << bits) - 1u;
-  uint local = (word >> ((shaft % per_word) * bits)) & mask;
+  uint local = (word >> ((shaft & ((1u << per_word_log2) - 1u)) * bits)) & mask;
   return local == mask ? LS_INVALID : ls.range_first + local;
 }
 
@@ -116,12 +120,12 @@ LS_FN void ls_window(IN(vec3) origin, IN(vec3) inv_dir, IN(vec3) box_lo, IN(vec3
 }
 
 // ls_lookup once the ray's line is known to cross shaft `shaft` of `ls`, entering and leaving the
-// LS box at t_in and t_out (ls_line_shaft): what a caller that loaded the shaft ahead of time runs.
-LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, float t_in, float t_out, IN(vec3) box_lo, IN(vec3) box_hi,
+// LS box at t_in and t_out (ls_line_shaft), and its candidate `prim` is read (ls_candidate): what a
+// caller that loads the shaft ahead of time runs.
+LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, float t_out, IN(vec3) box_lo, IN(vec3) box_hi,
                            IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, float tmin, float tmax, uint instance,
                            INOUT(Hit) hit, INOUT(uint) hit_prim) {
   ls_counters.lookups += 1u;
-  uint prim = ls_candidate(ls, shaft);
   if (prim == LS_INVALID) {
     ls_counters.empty += 1u;
     return LS_EMPTY;
@@ -192,5 +196,6 @@ LS_FN uint ls_lookup(uint ls_index, IN(vec3) box_lo, IN(vec3) box_hi, IN(vec3) o
     ls_counters.refused_no_shaft += 1u;
     return LS_FALLBACK;
   }
-  return ls_shaft_lookup(ls, shaft, t_in, t_out, box_lo, box_hi, origin, dir, inv_dir, tmin, tmax, instance, hit, hit_prim);
+  return ls_shaft_lookup(ls, shaft, ls_candidate(ls, shaft), t_in, t_out, box_lo, box_hi, origin, dir, inv_dir, tmin, tmax,
+                         instance, hit, hit_prim);
 }

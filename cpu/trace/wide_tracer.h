@@ -477,6 +477,7 @@ class WideTracer final : public FastTracer {
     // The lookup it is parked at (walk.child is its binary node).
     uint ls = LS_INVALID;
     uint shaft = 0;
+    uint prim_candidate = LS_INVALID;  // the shaft's candidate, read on the turn after parking
     uint reverse_shaft = 0;  // --ls-behind reverse: loaded too, in case the first candidate's plane hit is behind
     float t_in = 0.0f;
     float t_out = 0.0f;
@@ -516,8 +517,8 @@ class WideTracer final : public FastTracer {
       for (Flight& f : flights) {
         if (f.phase == Phase::Word) {
           const lsk::LsNode& node = c.ls_nodes[f.ls];
-          const uint prim = c.ls_candidate(node, f.shaft);
-          if (prim != LS_INVALID) __builtin_prefetch(&c.ls_records[prim]);
+          f.prim_candidate = c.ls_candidate(node, f.shaft);
+          if (f.prim_candidate != LS_INVALID) __builtin_prefetch(&c.ls_records[f.prim_candidate]);
           if (c.ls_reverse != 0u) {
             const uint reverse_prim = c.ls_candidate(node, f.reverse_shaft);
             if (reverse_prim != LS_INVALID) __builtin_prefetch(&c.ls_records[reverse_prim]);
@@ -641,20 +642,20 @@ class WideTracer final : public FastTracer {
 
   // Parks f at the Line Space lane its walk reached: its shaft, and the candidate word loading.
   // False where the lookup has no shaft to load (ls_lookup answers it at once).
-  bool park(const lsk::TraceContext& c, Flight& f) const {
+  bool park(lsk::TraceContext& c, Flight& f) const {
     const uint ls = f.q->use_ls ? c.node_ls[f.walk.child] : LS_INVALID;
     if (ls == LS_INVALID || c.ls_cos2 < 0.0f) return false;
     const lsk::LsNode& node = c.ls_nodes[ls];
     const ObjectQuery& q = *f.q;
     if (!lsk::ls_line_shaft(q.origin, q.dir, q.inv_dir, node.lo, node.hi, node.scale, node.n, f.shaft, f.t_in, f.t_out))
       return false;
-    __builtin_prefetch(&c.ls_candidates[node.candidates + f.shaft / (4u / node.bytes)]);
+    __builtin_prefetch(&c.ls_candidates[c.ls_candidate_word(node, f.shaft)]);
     if (c.ls_reverse != 0u) {  // the reverse shaft's candidate answers when the first's plane hit is behind tmin
       uint start_patch;
       uint end_patch;
       lsk::ls_shaft_patches(f.shaft, node.n, start_patch, end_patch);
       f.reverse_shaft = lsk::ls_shaft_index(end_patch, start_patch, node.n);
-      __builtin_prefetch(&c.ls_candidates[node.candidates + f.reverse_shaft / (4u / node.bytes)]);
+      __builtin_prefetch(&c.ls_candidates[c.ls_candidate_word(node, f.reverse_shaft)]);
     }
     f.ls = ls;
     f.phase = Phase::Word;
@@ -666,8 +667,8 @@ class WideTracer final : public FastTracer {
     ObjectQuery& q = *f.q;
     const uint b = f.walk.child;
     const lsk::BvhNode& node = c.nodes[b];
-    const uint answer = c.ls_shaft_lookup(c.ls_nodes[f.ls], f.shaft, f.t_in, f.t_out, node.lo, node.hi, q.origin, q.dir,
-                                          q.inv_dir, q.tmin, q.tmax, q.instance, f.hit, f.prim);
+    const uint answer = c.ls_shaft_lookup(c.ls_nodes[f.ls], f.shaft, f.prim_candidate, f.t_in, f.t_out, node.lo, node.hi,
+                                          q.origin, q.dir, q.inv_dir, q.tmin, q.tmax, q.instance, f.hit, f.prim);
     if (answered(c, b, answer, q, f.hit, f.prim)) return false;  // an occlusion query's hit
     if (!f.walk.pop(f.hit.t)) {
       if (!two_level_) return false;
