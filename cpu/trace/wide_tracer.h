@@ -13,8 +13,8 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <type_traits>
 
 namespace ls {
@@ -162,6 +162,13 @@ struct ExactWalk {
   void start(uint entry) {
     child = entry;
     count = 0;
+    sp = 0;
+  }
+
+  // A walk whose one step is the Line Space lane of binary node b (a BVH whose root has a Line Space).
+  void start_at_lane(uint b) {
+    child = b;
+    count = kLsLane;
     sp = 0;
   }
 
@@ -485,8 +492,6 @@ class WideTracer final : public FastTracer {
   enum class Flown { Parked, Over, Stopped };  // an object walk's turn: parked, ended, or ended the query
 
   void trace_in_flight(lsk::TraceContext& c, const lsk::Ray* rays, Hit* hits, size_t count, Query query) const {
-    const uint entry = part_->exact.entry_of[0];
-    const bool flat_walk = entry != LS_INVALID && c.node_ls[0] == LS_INVALID;  // trace_bvh's usual case
     Flight flights[kInFlight];
     size_t next = 0;
     // Starts the next ray that parks in f; the rays before it that finish without parking (or that
@@ -496,7 +501,7 @@ class WideTracer final : public FastTracer {
       while (next < count) {
         const size_t i = next++;
         const lsk::Ray& ray = rays[i];
-        if (!order_free_ray(ray.origin, ray.dir, ray.tmin) || ray.tmax != ray.tmax || (!two_level_ && !flat_walk)) {
+        if (!order_free_ray(ray.origin, ray.dir, ray.tmin) || ray.tmax != ray.tmax) {
           hits[i] = two_level_ ? trace_ray_reference(c, ray, true, query != Query::Closest) : trace_flat(c, ray, query);
           continue;
         }
@@ -504,7 +509,7 @@ class WideTracer final : public FastTracer {
         f.ray = &ray;
         f.hit = lsk::empty_hit(ray);
         f.prim = LS_INVALID;
-        if (two_level_ ? take_off_two_level(c, f, query) : take_off_flat(c, f, query, entry)) return;
+        if (two_level_ ? take_off_two_level(c, f, query) : take_off_flat(c, f, query)) return;
         hits[i] = lsk::finish_hit(f.hit);
       }
     };
@@ -535,12 +540,47 @@ class WideTracer final : public FastTracer {
   }
 
   // The first turn of a flat structure's ray: true when it parks.
-  bool take_off_flat(lsk::TraceContext& c, Flight& f, Query query, uint entry) const {
+  bool take_off_flat(lsk::TraceContext& c, Flight& f, Query query) const {
     const lsk::Ray& ray = *f.ray;
-    f.q.emplace(ray.origin, ray.dir, lsk::safe_reciprocal(ray.dir), ray.tmin, ray.tmax, LS_INVALID, query != Query::Closest,
-                true);
-    f.walk.start(entry);
+    if (start_object(c, f, 0u, ray.origin, ray.dir, LS_INVALID, query != Query::Closest, true) != Begun::Walk) return false;
     return fly_object(c, f) == Flown::Parked;
+  }
+
+  // What start_object found: an object walk to fly, nothing left to walk, or an occlusion query's hit.
+  enum class Begun { Walk, Over, Stopped };
+
+  // f's object walk in the BVH of root `root` for the (object-space) ray origin + t dir, which f.q
+  // will refer to: trace_bvh's set-up of an order-free walk.  What needs no walk is traced here: a
+  // root that is a leaf, and a ray outside the order-free walk's arithmetic (the reference kernel).
+  Begun start_object(lsk::TraceContext& c, Flight& f, uint root, const vec3& origin, const vec3& dir, uint instance,
+                     bool any_hit, bool use_ls) const {
+    const lsk::Ray& ray = *f.ray;
+    if (!order_free_ray(origin, dir, ray.tmin))
+      return trace_bvh_reference(c, root, origin, dir, ray.tmin, ray.tmax, instance, any_hit, use_ls, f.hit, f.prim)
+                 ? Begun::Stopped
+                 : Begun::Over;
+    const vec3 inv_dir = lsk::safe_reciprocal(dir);
+    const uint root_entry = part_->exact.entry_of[root];
+    const bool root_ls = c.node_ls[root] != LS_INVALID;
+    if (root_entry == LS_INVALID || root_ls) {  // a leaf, or a Line Space at the root: its box first
+      const lsk::BvhNode& node = c.nodes[root];
+      float t_root;
+      if (!lsk::ray_box(origin, inv_dir, ray.tmin, f.hit.t, node.lo, node.hi, t_root)) return Begun::Over;
+      if (!root_ls) {
+        BlockRay tri_ray;
+        make_block_ray(origin, dir, tri_ray);
+        return trace_blocks(c, blocks_, part_->blocks.lane_of[root], node.count, tri_ray, ray.tmin, instance, any_hit, f.hit,
+                            f.prim)
+                   ? Begun::Stopped
+                   : Begun::Over;
+      }
+    }
+    f.q.emplace(origin, dir, inv_dir, ray.tmin, ray.tmax, instance, any_hit, use_ls);
+    if (root_ls)
+      f.walk.start_at_lane(root);
+    else
+      f.walk.start(root_entry);
+    return Begun::Walk;
   }
 
   // The first turn of a two-level structure's ray (trace_two_level's set-up): true when it parks.
@@ -580,17 +620,9 @@ class WideTracer final : public FastTracer {
       if (f.next_instance < f.end_instance) {  // the next instance of the leaf: trace_bvh's cases
         const lsk::InstanceRecord& rec = c.instances[f.next_instance++];
         c.instance_ray(rec, ray.origin, ray.dir, f.object_origin, f.object_dir);
-        const uint root_entry = part_->exact.entry_of[rec.root];
-        if (root_entry != LS_INVALID && c.node_ls[rec.root] == LS_INVALID &&
-            order_free_ray(f.object_origin, f.object_dir, ray.tmin)) {
-          f.q.emplace(f.object_origin, f.object_dir, lsk::safe_reciprocal(f.object_dir), ray.tmin, ray.tmax, rec.instance,
-                      f.any_hit, use_ls);
-          f.walk.start(root_entry);
-          f.in_object = true;
-        } else if (trace_bvh(c, rec.root, f.object_origin, f.object_dir, ray.tmin, ray.tmax, rec.instance,
-                             f.any_hit ? Query::Occlusion : Query::Closest, use_ls, f.hit, f.prim)) {
-          return false;
-        }
+        const Begun begun = start_object(c, f, rec.root, f.object_origin, f.object_dir, rec.instance, f.any_hit, use_ls);
+        if (begun == Begun::Stopped) return false;
+        f.in_object = begun == Begun::Walk;
         continue;
       }
       if (f.top_over) return false;
