@@ -38,6 +38,14 @@ LS_FN void ls_shaft_patches(uint shaft, uint n, OUT(uint) start_patch, OUT(uint)
   end_patch = end_rank / nn >= start_face ? end_rank + nn : end_rank;
 }
 
+// The shaft of the same patches the other way round (end patch to start patch).
+LS_FN uint ls_reverse_shaft(uint shaft, uint n) {
+  uint start_patch;
+  uint end_patch;
+  ls_shaft_patches(shaft, n, start_patch, end_patch);
+  return ls_shaft_index(end_patch, start_patch, n);
+}
+
 // The point at (i + su, j + sv) / N on a patch of the box [lo, hi]; inv_n = 1 / N, computed once by
 // the host so that no device divides.
 LS_FN vec3 ls_patch_point(IN(vec3) lo, IN(vec3) hi, uint patch_id, uint n, float inv_n, float su, float sv) {

@@ -138,10 +138,7 @@ LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, flo
   float v;
   uint found = ls_plane_hit(prim, origin, dir, window_lo, window_hi, t, u, v);
   if (found == LS_PLANE_BEHIND && ls_reverse != 0u && t < tmin) {
-    uint start_patch;
-    uint end_patch;
-    ls_shaft_patches(shaft, ls.n, start_patch, end_patch);
-    prim = ls_candidate(ls, ls_shaft_index(end_patch, start_patch, ls.n));
+    prim = ls_candidate(ls, ls_reverse_shaft(shaft, ls.n));
     precise float half_patch = 0.5f * ls.inv_n * (t_out - t_in);
     precise float ahead = tmin + half_patch;
     if (prim != LS_INVALID) found = ls_plane_hit(prim, origin, dir, ahead, window_hi, t, u, v);

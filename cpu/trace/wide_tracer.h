@@ -683,10 +683,7 @@ class WideTracer final : public FastTracer {
       return false;
     __builtin_prefetch(&c.ls_candidates[c.ls_candidate_word(node, f.shaft)]);
     if (c.ls_reverse != 0u) {  // the reverse shaft's candidate answers when the first's plane hit is behind tmin
-      uint start_patch;
-      uint end_patch;
-      lsk::ls_shaft_patches(f.shaft, node.n, start_patch, end_patch);
-      f.reverse_shaft = lsk::ls_shaft_index(end_patch, start_patch, node.n);
+      f.reverse_shaft = lsk::ls_reverse_shaft(f.shaft, node.n);
       __builtin_prefetch(&c.ls_candidates[c.ls_candidate_word(node, f.reverse_shaft)]);
     }
     f.ls = ls;
