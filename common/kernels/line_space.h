@@ -23,11 +23,16 @@ LS_FN uint ls_shaft_count(uint n) { return 30u * n * n * n * n; }
 
 LS_FN uint ls_patch_index(uint face, uint i, uint j, uint n) { return face * n * n + j * n + i; }
 
+// The shaft of two patches whose faces are known: no division.
+LS_FN uint ls_shaft_index_on_faces(uint start_patch, uint start_face, uint end_patch, uint end_face, uint n) {
+  uint nn = n * n;
+  uint end_rank = end_face > start_face ? end_patch - nn : end_patch;
+  return start_patch * 5u * nn + end_rank;
+}
+
 LS_FN uint ls_shaft_index(uint start_patch, uint end_patch, uint n) {
   uint nn = n * n;
-  uint start_face = start_patch / nn;
-  uint end_rank = end_patch / nn > start_face ? end_patch - nn : end_patch;
-  return start_patch * 5u * nn + end_rank;
+  return ls_shaft_index_on_faces(start_patch, start_patch / nn, end_patch, end_patch / nn, n);
 }
 
 LS_FN void ls_shaft_patches(uint shaft, uint n, OUT(uint) start_patch, OUT(uint) end_patch) {
@@ -118,7 +123,7 @@ LS_FN bool ls_line_shaft(IN(vec3) origin, IN(vec3) dir, IN(vec3) inv_dir, IN(vec
   precise vec3 p_out = origin + dir * t_out;
   uint start_patch = ls_patch_of_point(p_in, lo, scale, in_face, n);
   uint end_patch = ls_patch_of_point(p_out, lo, scale, out_face, n);
-  shaft = ls_shaft_index(start_patch, end_patch, n);
+  shaft = ls_shaft_index_on_faces(start_patch, in_face, end_patch, out_face, n);
   return true;
 }
 
