@@ -263,6 +263,82 @@ TEST_CASE("wide BVH: rays traced in flight get the hits and counters each gets a
   }
 }
 
+TEST_CASE("wide BVH: --skip leaves out the lookups, or the walks of refused subtrees, and nothing else", "[wide]") {
+  // Without lookups every Line Space lane answers "empty": the closest hit is the closest of the
+  // triangles outside every Line Space node's range, found here by brute force.  At refusal angle 0
+  // every lookup refuses, so leaving out the refused walks must answer the same.
+  size_t outside_hits = 0;  // hits outside the Line Space nodes: the brute force is not empty
+  for (const char* scene_name : {"builtin:cornell", "random"}) {
+    const ls::Scene scene = std::string(scene_name) == "random" ? random_scene(6) : ls::load_scene(scene_name);
+    const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));
+    std::vector<lsk::Ray> rays = ls::generate_rays(scene, exact, ls::RayKind::Diffuse, 1000, 17);
+    const std::vector<lsk::Ray> random = ls::generate_rays(scene, exact, ls::RayKind::Random, 1000, 17);
+    rays.insert(rays.end(), random.begin(), random.end());
+    for (const char* s : {"f-ls:0:4", "f-ls:4:4", "f-ls:8:6"}) {
+      // Subtrees of fewer than 8 triangles get no Line Space: hits outside them too.
+      const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(8, 8));
+      std::vector<bool> under_ls(a.tris.size(), false);
+      for (const lsk::LsNode& node : a.ls_nodes)
+        for (uint32_t i = node.range_first; i < node.range_first + node.range_count; ++i) under_ls[i] = true;
+      std::vector<lsk::Hit> outside(rays.size());
+      for (size_t r = 0; r < rays.size(); ++r) {
+        const lsk::Ray& ray = rays[r];
+        const lsk::TriRay tri_ray = lsk::make_tri_ray(ray.origin, ray.dir);
+        lsk::Hit hit = lsk::empty_hit(ray);
+        for (size_t i = 0; i < a.tris.size(); ++i) {
+          float t, u, v;
+          const lsk::Triangle& tri = a.tris[i];
+          if (!under_ls[i] && lsk::ray_triangle(tri_ray, ray.tmin, hit.t, glm::vec3(tri.v0), glm::vec3(tri.v1), glm::vec3(tri.v2), t, u, v))
+            lsk::offer_hit(t, u, v, a.tri_instances[i], a.tri_ids[i], hit);
+        }
+        outside[r] = lsk::finish_hit(hit);
+      }
+      std::vector<lsk::Hit> full(rays.size());
+      ls::trace_rays(a, {}, rays.data(), full.data(), rays.size(), false, nullptr, ls::Traversal::Fast);
+      size_t changed = 0;  // rays whose full answer comes from a Line Space node: the skip must show
+      for (size_t r = 0; r < rays.size(); ++r) changed += std::memcmp(&full[r], &outside[r], sizeof(lsk::Hit)) != 0;
+      INFO(scene_name << ", " << s << ": " << changed << " rays answered from Line Space nodes");
+      CHECK(changed > 0);
+      for (const auto& [skip, angle] : {std::pair{ls::LsSkip::Lookups, 45.0f}, std::pair{ls::LsSkip::Lookups, 0.0f},
+                                        std::pair{ls::LsSkip::RefusedWalks, 0.0f}}) {
+        ls::LsLookup lookup;
+        lookup.skip = skip;
+        lookup.angle_degrees = angle;
+        INFO((skip == ls::LsSkip::Lookups ? "without lookups" : "without refused walks") << ", angle " << angle);
+        std::vector<lsk::Hit> hits(rays.size()), blocked(rays.size());
+        lsk::LsCounters counters{};
+        ls::trace_rays(a, lookup, rays.data(), hits.data(), rays.size(), false, &counters, ls::Traversal::Fast);
+        ls::trace_occlusion(a, lookup, rays.data(), blocked.data(), rays.size(), nullptr, ls::Traversal::Fast);
+        size_t mismatches = 0, wrong_occlusion = 0, hit_count = 0;
+        for (size_t r = 0; r < rays.size(); ++r) {
+          mismatches += std::memcmp(&hits[r], &outside[r], sizeof(lsk::Hit)) != 0;
+          wrong_occlusion += (blocked[r].triangle != lsk::LS_INVALID) != (outside[r].triangle != lsk::LS_INVALID);
+          hit_count += outside[r].triangle != lsk::LS_INVALID;
+        }
+        CHECK(mismatches == 0);
+        CHECK(wrong_occlusion == 0);
+        outside_hits += hit_count;
+        if (skip == ls::LsSkip::Lookups)
+          CHECK(counters.lookups == 0);
+        else
+          CHECK(counters.refused_angle == counters.lookups);
+      }
+    }
+  }
+  CHECK(outside_hits > 0);
+  // The reference kernels and the fast path's any hit (which runs them) do not know --skip.
+  const ls::Scene scene = ls::load_scene("builtin:cornell");
+  const ls::Accel a = ls::build_accel(scene, ls::parse_structure("f-ls:4:4"), options(8));
+  const std::vector<lsk::Ray> rays = ls::generate_rays(scene, a, ls::RayKind::Diffuse, 10, 1);
+  std::vector<lsk::Hit> hits(rays.size());
+  ls::LsLookup lookup;
+  lookup.skip = ls::LsSkip::Lookups;
+  CHECK_THROWS_AS(ls::trace_rays(a, lookup, rays.data(), hits.data(), rays.size(), false, nullptr, ls::Traversal::Reference),
+                  ls::InputError);
+  CHECK_THROWS_AS(ls::trace_rays(a, lookup, rays.data(), hits.data(), rays.size(), true, nullptr, ls::Traversal::Fast),
+                  ls::InputError);
+}
+
 TEST_CASE("wide BVH: same answers for axis-parallel, grazing, boundary and degenerate rays", "[wide]") {
   const ls::Scene scene = random_scene(4);
   StdRng rng(99);

@@ -50,6 +50,9 @@ lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
     c.ls_enabled = 1;
     c.ls_cos2 = ls_cos2(lookup);
     c.ls_reverse = lookup.reverse_behind ? 1u : 0u;
+    c.ls_skip = lookup.skip == LsSkip::RefusedWalks ? lsk::TraceContext::LS_SKIP_REFUSED_WALKS
+                : lookup.skip == LsSkip::Lookups    ? lsk::TraceContext::LS_SKIP_LOOKUPS
+                                                    : 0u;
   }
   return c;
 }

@@ -56,11 +56,17 @@ struct LsBuildOptions {
   std::function<void(size_t done, size_t total)> progress;
 };
 
+// What linespace-profile --skip leaves out of a Line Space structure's timing on the fast path, so
+// that the time of the rest shows: the exact walks of subtrees whose lookup refused, or every
+// lookup (each Line Space lane then answers "empty").  The answers are wrong then; nothing else sets it.
+enum class LsSkip { Nothing, RefusedWalks, Lookups };
+
 // What a Line Space lookup reads besides the structure: it travels with each trace and render call
 // (trace_rays, RenderOptions::lookup), so changing it never rebuilds a Line Space.
 struct LsLookup {
   float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
   bool reverse_behind = false;   // --ls-behind reverse: a plane hit behind the origin asks the reverse shaft (ls_lookup.h)
+  LsSkip skip = LsSkip::Nothing;
 };
 
 // 2l-ls:auto's planner inputs (cpu/build/ls_budget.h).

@@ -28,6 +28,9 @@ struct TraceContext {
   float ls_cos2 = -1.0f;
   uint ls_reverse = 0;  // --ls-behind reverse (ls_lookup.h)
   uint walk_far_first = 0;  // tests: the farther child first (traverse_bvh.h)
+  uint ls_skip = 0;  // linespace-profile --skip, read by the fast path only (LsSkip, accel.h)
+  static constexpr uint LS_SKIP_REFUSED_WALKS = 1u;
+  static constexpr uint LS_SKIP_LOOKUPS = 2u;
   LsCounters ls_counters{};  // the shader keeps these in a private variable too
   TraceWork trace_work{};    // box and triangle tests of the reference traversal (shaders count nothing)
   // Per node of nodes[], non-zero in a Line Space node's subtree (line_space_subtrees(), accel.h):

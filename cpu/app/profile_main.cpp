@@ -7,6 +7,8 @@
 //   valgrind --tool=callgrind --toggle-collect='ls::trace_rays*' linespace-profile SCENE STRUCTURE RAYS
 // Timing: the best of --repeat runs, in ns per ray (one thread; compare binaries, not machines).
 // --lookups: the Line Space lookups alone instead (lookup_timing.h).
+// --skip refused-walks|lookups: a Line Space structure's fast path with that work left out (LsSkip,
+// accel.h), so that a run beside the full one shows what the work costs; the answers are then wrong.
 #include "common/base/ray_files.h"
 #include "common/structure/accel.h"
 #include "cpu/app/lookup_timing.h"
@@ -30,7 +32,8 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
-               "--occlusion | --lookups] [--ls-min-triangles M] [--ls-behind exact|reverse] [--embree-isa ISA] [--exact-width 4|8]\n");
+               "--occlusion | --lookups] [--ls-min-triangles M] [--ls-behind exact|reverse] [--skip refused-walks|lookups] "
+               "[--embree-isa ISA] [--exact-width 4|8]\n");
   return 2;
 }
 
@@ -56,10 +59,20 @@ int main(int argc, char** argv) try {
     else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
     else if (a == "--ls-behind" && i + 1 < argc && (std::string(argv[i + 1]) == "exact" || std::string(argv[i + 1]) == "reverse"))
       lookup.reverse_behind = std::string(argv[++i]) == "reverse";
+    else if (a == "--skip" && i + 1 < argc) {
+      const std::string what = argv[++i];
+      if (what == "refused-walks") lookup.skip = ls::LsSkip::RefusedWalks;
+      else if (what == "lookups") lookup.skip = ls::LsSkip::Lookups;
+      else return usage();
+    }
     else if (a == "--exact-width" && i + 1 < argc) options.exact_width = std::atoi(argv[++i]);  // 4 or 8, else InputError
     else return usage();
   }
   if (repeat < 1) return usage();
+  if (lookup.skip != ls::LsSkip::Nothing && (path != Path::Fast || query == Query::AnyHit || query == Query::Lookups)) {
+    std::fprintf(stderr, "linespace-profile: --skip times the fast path's closest-hit and occlusion queries only\n");
+    return 2;
+  }
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const ls::Scene scene = ls::load_scene(argv[1]);
   const std::vector<lsk::Ray> rays = ls::read_rays(argv[3]);
@@ -92,8 +105,11 @@ int main(int argc, char** argv) try {
   }
   size_t blocked = 0;
   for (const lsk::Hit& h : hits) blocked += h.triangle != lsk::LS_INVALID;
-  std::printf("%s, %s path: %.1f ns per ray (best of %d, one thread), %zu of %zu rays hit\n",
-              path == Path::Embree ? ("embree (" + embree->isa() + ")").c_str() : argv[2],
+  const std::string skipped = lookup.skip == ls::LsSkip::RefusedWalks ? " without refused walks"
+                              : lookup.skip == ls::LsSkip::Lookups    ? " without lookups"
+                                                                      : "";
+  std::printf("%s%s, %s path: %.1f ns per ray (best of %d, one thread), %zu of %zu rays hit\n",
+              path == Path::Embree ? ("embree (" + embree->isa() + ")").c_str() : argv[2], skipped.c_str(),
               path == Path::Fast ? "fast" : path == Path::Reference ? "reference" : "Embree's", best / double(rays.size()) * 1e9,
               repeat, blocked, rays.size());
   return 0;

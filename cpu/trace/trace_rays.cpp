@@ -54,6 +54,9 @@ void trace_chunks(const Accel& accel, const LsLookup& lookup, const lsk::Ray* ra
                   lsk::LsCounters* counters, Traversal traversal, TraceWorkTotals* work,
                   const std::vector<uint8_t>* ls_subtrees) {
   lsk::TraceContext context = trace_context(accel, lookup);
+  // The fast path's any hit runs the reference kernels, which know nothing of --skip.
+  if (lookup.skip != LsSkip::Nothing && (traversal != Traversal::Fast || !accel.fast || (any_hit && !occlusion)))
+    throw InputError("--skip times the fast path's closest-hit and occlusion queries only");
   if (work && ls_subtrees && !ls_subtrees->empty()) context.node_in_ls = ls_subtrees->data();
   const FastTracer* fast = traversal == Traversal::Fast ? accel.fast.get() : nullptr;  // none: hand-made Accel
   // Per-thread counters, summed once at the end: no lock on the hot path.

@@ -430,10 +430,17 @@ class WideTracer final : public FastTracer {
   __attribute__((noinline)) bool ls_node(lsk::TraceContext& c, uint b, ObjectQuery& q, Hit& hit, uint& hit_prim) const {
     const lsk::BvhNode& node = c.nodes[b];
     const uint ls = q.use_ls ? c.node_ls[b] : LS_INVALID;
+    if (ls != LS_INVALID && c.ls_skip == lsk::TraceContext::LS_SKIP_LOOKUPS) return false;  // profiling: "empty"
     const uint answer = ls == LS_INVALID ? lsk::TraceContext::LS_FALLBACK
                                          : c.ls_lookup(ls, node.lo, node.hi, q.origin, q.dir, q.inv_dir, q.tmin, q.tmax,
                                                        q.instance, hit, hit_prim);
+    if (ls != LS_INVALID && skipped_walk(c, answer)) return false;
     return answered(c, b, answer, q, hit, hit_prim);
+  }
+
+  // linespace-profile --skip refused-walks: a refused lookup's subtree is not walked.
+  static LS_ALWAYS_INLINE bool skipped_walk(const lsk::TraceContext& c, uint answer) {
+    return answer == lsk::TraceContext::LS_FALLBACK && c.ls_skip == lsk::TraceContext::LS_SKIP_REFUSED_WALKS;
   }
 
   // What a lookup's answer at binary node b asks: nothing more (accepted, empty), or the subtree's
@@ -673,10 +680,10 @@ class WideTracer final : public FastTracer {
   }
 
   // Parks f at the Line Space lane its walk reached: its shaft, and the candidate word loading.
-  // False where the lookup has no shaft to load (ls_lookup answers it at once).
+  // False where the lookup has no shaft to load (ls_node answers it at once).
   bool park(lsk::TraceContext& c, Flight& f) const {
     const uint ls = f.q->use_ls ? c.node_ls[f.walk.child] : LS_INVALID;
-    if (ls == LS_INVALID || c.ls_cos2 < 0.0f) return false;
+    if (ls == LS_INVALID || c.ls_cos2 < 0.0f || c.ls_skip == lsk::TraceContext::LS_SKIP_LOOKUPS) return false;
     const lsk::LsNode& node = c.ls_nodes[ls];
     const ObjectQuery& q = *f.q;
     if (!lsk::ls_line_shaft(q.origin, q.dir, q.inv_dir, node.lo, node.hi, node.scale, node.n, f.shaft, f.t_in, f.t_out))
@@ -698,7 +705,7 @@ class WideTracer final : public FastTracer {
     const lsk::BvhNode& node = c.nodes[b];
     const uint answer = c.ls_shaft_lookup(c.ls_nodes[f.ls], f.shaft, f.prim_candidate, f.t_in, f.t_out, node.lo, node.hi,
                                           q.origin, q.dir, q.inv_dir, q.tmin, q.tmax, q.instance, f.hit, f.prim);
-    if (answered(c, b, answer, q, f.hit, f.prim)) return false;  // an occlusion query's hit
+    if (!skipped_walk(c, answer) && answered(c, b, answer, q, f.hit, f.prim)) return false;  // an occlusion query's hit
     if (!f.walk.pop(f.hit.t)) {
       if (!two_level_) return false;
       f.in_object = false;  // the instance's walk is over: the top walk goes on
