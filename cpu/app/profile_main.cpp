@@ -90,11 +90,12 @@ int main(int argc, char** argv) try {
       ls::time_lookups(accel, lookup, rays, repeat);
       return 0;
     }
+    // By value: run() is called after this block, where a reference to traversal would dangle.
     const ls::Traversal traversal = path == Path::Fast ? ls::Traversal::Fast : ls::Traversal::Reference;
     if (query == Query::Occlusion)
-      run = [&] { ls::trace_occlusion(accel, lookup, rays.data(), hits.data(), rays.size(), nullptr, traversal); };
+      run = [&, traversal] { ls::trace_occlusion(accel, lookup, rays.data(), hits.data(), rays.size(), nullptr, traversal); };
     else
-      run = [&] { ls::trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal); };
+      run = [&, traversal] { ls::trace_rays(accel, lookup, rays.data(), hits.data(), rays.size(), any_hit, nullptr, traversal); };
   }
   double best = 0.0;
   for (int r = 0; r < repeat; ++r) {
