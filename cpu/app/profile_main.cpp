@@ -86,6 +86,8 @@ int main(int argc, char** argv) try {
     run = [&] { embree->trace(rays.data(), hits.data(), rays.size(), any_hit); };
   } else {
     accel = ls::build_planned_accel(scene, ls::parse_structure(argv[2]), options);
+    if (lookup.skip != ls::LsSkip::Nothing && accel.ls_nodes.empty())
+      throw ls::InputError("--skip needs a structure with Line Space nodes");
     if (query == Query::Lookups) {
       ls::time_lookups(accel, lookup, rays, repeat);
       return 0;

@@ -2,7 +2,8 @@
 # linespace-profile --skip leaves work out of a Line Space structure's fast path and says so: without
 # lookups a Line Space at the root (f-ls:0:N, every triangle below it) leaves no ray a hit, and a
 # structure with one at depth 4 still has some.  Paths and queries that do not know --skip (the
-# reference, Embree, any hit, --lookups) and an unknown value are refused with exit 2.
+# reference, Embree, any hit, --lookups), a structure without Line Space nodes and an unknown value
+# are refused with exit 2.
 #   tests/profile/check_skip.sh BUILD_DIR
 set -euo pipefail
 build=$1
@@ -22,6 +23,11 @@ full=$("$profile" builtin:cornell f-ls:0:4 "$tmp/rays" --ls-min-triangles 0 | hi
 out=$("$profile" builtin:cornell f-ls:4:4 "$tmp/rays" --skip refused-walks)
 [[ $out == "f-ls:4:4 without refused walks, fast path: "* ]] || fail "the line does not say what was left out: $out"
 [[ $(hits <<< "$out") -gt 0 ]] || fail "f-ls:4:4 without refused walks hit nothing: $out"
+
+rc=0
+"$profile" builtin:cornell bvh "$tmp/rays" --skip lookups > /dev/null 2> "$tmp/err" || rc=$?
+[[ $rc == 2 ]] || fail "bvh --skip lookups: exit $rc, expected 2"
+grep -q -- "--skip needs a structure with Line Space nodes" "$tmp/err" || fail "bvh --skip lookups: $(cat "$tmp/err")"
 
 for flags in "--skip lookups --reference" "--skip lookups --embree" "--skip refused-walks --any-hit" \
              "--skip lookups --lookups" "--skip everything"; do
