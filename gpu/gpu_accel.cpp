@@ -43,7 +43,7 @@ void GpuAccel::upload_top_level(const Accel& accel) {
 lsk::ShaderParams GpuAccel::params(const LsLookup& lookup) const {
   lsk::ShaderParams p = params_;
   p.ls_cos2 = ls_cos2(lookup);  // the CPU's arithmetic, so both sides agree
-  p.ls_reverse = lookup.reverse_behind ? 1u : 0u;
+  p.ls_behind = ls_behind_code(lookup);
   return p;
 }
 

@@ -146,6 +146,42 @@ TEST_CASE("rays, trace and build agree with the file formats and JSON keys", "[c
       CHECK(o.contains(key));
 }
 
+TEST_CASE("trace --ls-behind reaches the lookup: exact, empty and reverse answer the rays from inside the box as documented", "[cli]") {
+  fs::create_directories(temp(""));
+  const std::string rays = temp("behind.rays").string(), hits = temp("behind.hits").string();
+  REQUIRE(run("rays --scene builtin:cornell --kind diffuse --count 1000 --seed 3 --out " + rays).status == 0);
+  // f-ls:0:4: one Line Space, at the root, which holds every origin: one lookup a ray, its first
+  // candidate mostly behind the origin.
+  struct Counted {
+    unsigned lookups = 0, empty = 0, accepted = 0, behind = 0;
+  };
+  auto trace = [&](const char* mode) {
+    const Run r = run("trace --scene builtin:cornell --structure f-ls:0:4 --ls-behind " + std::string(mode) + " --rays " + rays +
+                      " --hits " + hits);
+    REQUIRE(r.status == 0);
+    Counted c;
+    const std::string printed = r.out + r.err;
+    const size_t at = printed.find("line space:");
+    REQUIRE(at != std::string::npos);
+    REQUIRE(std::sscanf(printed.c_str() + at, "line space: %u lookups, %u empty shafts, %u accepted, refused %*u (angle %*u, before the window %u",
+                        &c.lookups, &c.empty, &c.accepted, &c.behind) == 4);
+    return c;
+  };
+  const Counted exact = trace("exact"), empty = trace("empty"), reverse = trace("reverse");
+  INFO("exact " << exact.empty << " empty, " << exact.accepted << " accepted, " << exact.behind << " behind; empty mode "
+                << empty.empty << ", " << empty.accepted << ", " << empty.behind << "; reverse " << reverse.empty << ", "
+                << reverse.accepted << ", " << reverse.behind);
+  REQUIRE(exact.lookups == 1000u);
+  REQUIRE(empty.lookups == 1000u);
+  CHECK(exact.behind > 500u);
+  CHECK(empty.empty > exact.empty);                                    // the reverse shaft's "nothing ahead"
+  CHECK(empty.empty == reverse.empty);                                 // the same ones as reverse's
+  CHECK(empty.accepted == exact.accepted);                             // its candidates never answer
+  CHECK(empty.behind + (empty.empty - exact.empty) == exact.behind);   // the rest refused as behind
+  CHECK(reverse.accepted > exact.accepted);
+  CHECK(reverse.behind < empty.behind);
+}
+
 TEST_CASE("bench prints DESIGN 9's JSON keys for each structure and Embree, closest hit and occlusion", "[cli]") {
   for (const char* kind : {"diffuse", "shadow"}) {
     const Run r = run(std::string("bench --scene builtin:cornell --count 2000 --repeat 1 --structures 2l-bvh,f-ls:3:3 --json --kind ") + kind);

@@ -148,15 +148,18 @@ TEST_CASE("GPU hits equal the CPU's bit for bit for all four structures closest 
   for (const char* s : {"bvh", "2l-bvh", "f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random);
 }
 
-TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse", "[gpu]") {
-  LsLookup reverse;
-  reverse.reverse_behind = true;
+TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse and empty", "[gpu]") {
   const Scene cornell = load_scene("builtin:cornell");
   const std::vector<lsk::Ray> diffuse = diffuse_rays(cornell, 20000, 3);
-  for (const char* s : {"f-ls:3:6", "2l-ls:2:6", "2l-ls:0:10"}) require_hits_equal(cornell, s, diffuse, paper(), reverse);
   const Scene objects = load_scene("builtin:generated:1200:3:5");
   const std::vector<lsk::Ray> random = random_rays(objects, 20000, 4);  // origins inside LS boxes
-  for (const char* s : {"f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random, paper(), reverse);
+  for (LsBehind behind : {LsBehind::Reverse, LsBehind::Empty}) {
+    INFO(ls_behind_name(behind));
+    LsLookup lookup;
+    lookup.behind = behind;
+    for (const char* s : {"f-ls:3:6", "2l-ls:2:6", "2l-ls:0:10"}) require_hits_equal(cornell, s, diffuse, paper(), lookup);
+    for (const char* s : {"f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random, paper(), lookup);
+  }
 }
 
 TEST_CASE("GPU hits equal the CPU's at the extremes - flat boxes and scales 1e-20 and 1e20 and offset 1e6", "[gpu]") {
@@ -231,7 +234,7 @@ TEST_CASE("a GPU render gives the CPU render's images bit for bit", "[gpu]") {
   // mode give other images, and the same ones on both back ends.
   RenderOptions other = options;
   other.lookup.angle_degrees = 10.0f;
-  other.lookup.reverse_behind = true;
+  other.lookup.behind = LsBehind::Reverse;
   const RenderResult cpu_other = render(cornell, cpu_built, other);
   const RenderResult gpu_other = gpu::render_gpu(device(), cornell, gpu_built, other);
   REQUIRE(std::memcmp(cpu_other.total.data(), gpu_other.total.data(), cpu_other.total.size() * sizeof(glm::vec3)) == 0);

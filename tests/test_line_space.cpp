@@ -83,10 +83,10 @@ AccelOptions paper() {
 }
 
 // The lookup at a refusal angle, with the behind mode.
-LsLookup angle(float degrees, bool reverse_behind = false) {
+LsLookup angle(float degrees, LsBehind behind = LsBehind::Exact) {
   LsLookup l;
   l.angle_degrees = degrees;
-  l.reverse_behind = reverse_behind;
+  l.behind = behind;
   return l;
 }
 
@@ -341,35 +341,53 @@ TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes inc
   }
 }
 
-TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse, which refuses fewer as behind", "[line_space]") {
+TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse and empty, which refuse fewer as behind", "[line_space]") {
   const Scene scene = single_mesh_scene(unit_cube_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
-  const LsLookup reverse = angle(89.0f, true);
+  const LsLookup reverse = angle(89.0f, LsBehind::Reverse), empty = angle(89.0f, LsBehind::Empty);
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
     INFO(name);
-    lsk::LsCounters exact_counters{}, reverse_counters{};
+    lsk::LsCounters exact_counters{}, reverse_counters{}, empty_counters{};
     const Accel a = build_accel(scene, parse_structure(name), paper());  // one build: the lookup alone differs
     trace_all(a, rays, false, &exact_counters, angle(89.0f));
     const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &reverse_counters, reverse);
+    const std::vector<lsk::Hit> empty_hits = trace_all(a, rays, false, &empty_counters, empty);
     // Behind the origin answers with reverse; before the node's box (an origin outside it) refuses
     // in both modes.
     REQUIRE(exact_counters.refused_behind > 0);
     CHECK(reverse_counters.refused_behind < exact_counters.refused_behind);
     // The behind refusals became answers: more accepted or empty, the same lookups before them.
     CHECK(reverse_counters.accepted + reverse_counters.empty > exact_counters.accepted + exact_counters.empty);
+    // empty: the same "nothing ahead" answers as reverse, and every other behind lookup refused as in
+    // exact mode.  Exactly so where a ray makes one lookup (the root's); elsewhere the answers change
+    // which nodes a ray reaches.
+    if (std::string(name) == "f-ls:0:4") {
+      CHECK(empty_counters.lookups == exact_counters.lookups);
+      CHECK(empty_counters.empty == reverse_counters.empty);
+      CHECK(empty_counters.accepted == exact_counters.accepted);
+      CHECK(empty_counters.refused_behind + (empty_counters.empty - exact_counters.empty) == exact_counters.refused_behind);
+      CHECK(empty_counters.refused_angle == exact_counters.refused_angle);
+    }
+    CHECK(empty_counters.empty > exact_counters.empty);
+    CHECK(empty_counters.refused_behind < exact_counters.refused_behind);
+    CHECK(empty_counters.refused_behind > reverse_counters.refused_behind);
     CHECK(require_in_interval(hits, rays) > 0);
+    CHECK(require_in_interval(empty_hits, rays) > 0);
     require_in_interval(trace_all(a, rays, true, nullptr, reverse), rays);
+    require_in_interval(trace_all(a, rays, true, nullptr, empty), rays);
   }
   // A refusal angle of 0 still refuses everything: the exact structure's hits.
-  REQUIRE(same_bits(trace_all(build_accel(scene, parse_structure("f-ls:3:6"), paper()), rays, false, nullptr, angle(0.0f, true)),
-                    trace_all(build_accel(scene, parse_structure("bvh"), paper()), rays)));
+  const std::vector<lsk::Hit> bvh = trace_all(build_accel(scene, parse_structure("bvh"), paper()), rays);
+  const Accel fls = build_accel(scene, parse_structure("f-ls:3:6"), paper());
+  for (LsBehind behind : {LsBehind::Reverse, LsBehind::Empty})
+    REQUIRE(same_bits(trace_all(fls, rays, false, nullptr, angle(0.0f, behind)), bvh));
 }
 
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 }  // namespace
 
-TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the reverse shaft's candidate answers, or says nothing is ahead", "[line_space]") {
+TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the reverse shaft's candidate answers, or says nothing is ahead, and with empty only the latter", "[line_space]") {
   // Two parallel planes z = 0 and z = 1 and a wall at x = -0.9 that makes the box reach z = -1 .. 2,
   // so that neither plane lies on a face of the Line Space box.
   Mesh m;
@@ -412,9 +430,10 @@ TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the r
     for (size_t i = 0; i < rays.size(); ++i) {
       INFO("ray " << i);
       const std::vector<lsk::Ray> one = {rays[i]};
-      lsk::LsCounters e{}, r{};
+      lsk::LsCounters e{}, r{}, m{};
       const lsk::Hit got_exact = trace_all(a, one, false, &e, angle(45.0f))[0];
-      const lsk::Hit got = trace_all(a, one, false, &r, angle(45.0f, true))[0];
+      const lsk::Hit got = trace_all(a, one, false, &r, angle(45.0f, LsBehind::Reverse))[0];
+      const lsk::Hit got_empty = trace_all(a, one, false, &m, angle(45.0f, LsBehind::Empty))[0];
       REQUIRE(e.refused_behind == 1);  // every ray starts behind its shaft's first candidate
       REQUIRE(r.refused_behind == 0);
       REQUIRE(got_exact.t == want[i].t);  // refused: the subtree traversed exactly
@@ -422,15 +441,20 @@ TEST_CASE("behind the origin with --ls-behind reverse: from inside the box the r
         REQUIRE(r.accepted == 1);  // the reverse shaft's candidate is the plane ahead
         REQUIRE(got.triangle != lsk::LS_INVALID);
         REQUIRE(got.t == Approx(want[i].t).epsilon(1e-5));
+        REQUIRE(m.refused_behind == 1);  // empty mode: a candidate ahead does not answer
+        REQUIRE(got_empty.t == want[i].t);
       } else {
         REQUIRE(r.empty == 1);  // the reverse shaft's candidate is the plane the ray leaves
         REQUIRE(got.triangle == lsk::LS_INVALID);
+        REQUIRE(m.empty == 1);
+        REQUIRE(m.refused_behind == 0);
+        REQUIRE(got_empty.triangle == lsk::LS_INVALID);
       }
     }
   }
 }
 
-TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as documented, on a hand-made Line Space", "[line_space]") {
+TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decides as documented, on a hand-made Line Space", "[line_space]") {
   // One LS box [-1, 1]^2 x [-1, 2], N = 4.  Shafts starting on the -Z face hold the plane z = 0 (L),
   // those starting on +Z the triangle U under test, every other shaft is empty.  The rays start just
   // above L, so their shaft's candidate L lies behind them and the reverse shaft's is U (or empty).
@@ -492,7 +516,7 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
     const std::vector<lsk::Triangle> tris = {horizontal(0.0f), k.u};
     const std::vector<lsk::LsRecord> records = {ls::make_ls_record(tris[0], glm::uvec3(up), 0u),
                                                 ls::make_ls_record(tris[1], glm::uvec3(k.u_normal), 1u)};
-    for (uint32_t reverse : {0u, 1u}) {
+    for (uint32_t behind : {C::LS_BEHIND_EXACT, C::LS_BEHIND_REVERSE, C::LS_BEHIND_EMPTY}) {
       C c;
       c.tris = tris.data();
       c.tri_ids = ids.data();
@@ -501,7 +525,7 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
       c.ls_candidates = candidates.data();
       c.ls_records = records.data();
       c.ls_cos2 = 0.5f;  // 45 degrees
-      c.ls_reverse = reverse;
+      c.ls_behind = behind;
       const glm::vec3 origin(0.5f, 0.1f, 1e-4f), dir = glm::normalize(k.dir);
       lsk::Hit hit{};
       hit.t = k.current_t;
@@ -512,9 +536,12 @@ TEST_CASE("behind the origin with --ls-behind reverse, the lookup decides as doc
           c.ls_lookup(0, node.lo, node.hi, origin, dir, lsk::safe_reciprocal(dir), 0.0f, k.tmax, lsk::LS_INVALID, hit, prim);
       uint32_t counted;
       std::memcpy(&counted, reinterpret_cast<const char*>(&c.ls_counters) + k.counter_offset, sizeof counted);
-      if (reverse == 0u) {  // the documented default: behind the origin, refused
+      // The documented default: behind the origin, refused; with empty, every answer but "empty".
+      if (behind == C::LS_BEHIND_EXACT || (behind == C::LS_BEHIND_EMPTY && k.answer != C::LS_EMPTY)) {
         CHECK(answer == C::LS_FALLBACK);
         CHECK(c.ls_counters.refused_behind == 1u);
+        CHECK(c.ls_counters.lookups == 1u);
+        CHECK(prim == lsk::LS_INVALID);
         continue;
       }
       CHECK(answer == k.answer);

@@ -195,7 +195,7 @@ TEST_CASE("wide BVH: same answers at refusal angles 0 and 89 degrees and with sm
       }
 }
 
-TEST_CASE("wide BVH: same answers with --ls-behind reverse, in either walk order", "[wide]") {
+TEST_CASE("wide BVH: same answers with --ls-behind reverse and empty, in either walk order", "[wide]") {
   for (const char* scene_name : {"builtin:cornell", "builtin:generated:30000:12:5"}) {
     const ls::Scene scene = ls::load_scene(scene_name);
     const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));
@@ -204,11 +204,13 @@ TEST_CASE("wide BVH: same answers with --ls-behind reverse, in either walk order
       for (int width : {4, 8})
         for (const char* s : {"f-ls:4:4", "f-ls:8:6", "2l-ls:2:4", "2l-ls:0:6"}) {
           const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width));
-          ls::LsLookup reverse;
-          reverse.reverse_behind = true;
-          const std::string what = std::string(scene_name) + ", " + kind + " rays, reverse";
-          CHECK(require_same(a, rays, false, what, reverse) > 0);
-          CHECK(require_same(a, rays, true, what, reverse) > 0);
+          for (ls::LsBehind behind : {ls::LsBehind::Reverse, ls::LsBehind::Empty}) {
+            ls::LsLookup lookup;
+            lookup.behind = behind;
+            const std::string what = std::string(scene_name) + ", " + kind + " rays, " + ls::ls_behind_name(behind);
+            CHECK(require_same(a, rays, false, what, lookup) > 0);
+            CHECK(require_same(a, rays, true, what, lookup) > 0);
+          }
         }
     }
   }
@@ -227,11 +229,11 @@ TEST_CASE("wide BVH: rays traced in flight get the hits and counters each gets a
     for (const char* s : {"f-ls:0:4", "f-ls:4:4", "f-ls:8:6", "2l-ls:2:4", "2l-ls:0:6"}) {
       const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(8));
       for (const auto& [kind, rays] : sets)
-        for (bool reverse : {false, true})
+        for (ls::LsBehind behind : {ls::LsBehind::Exact, ls::LsBehind::Empty, ls::LsBehind::Reverse})
           for (bool occlusion : {false, true}) {
             ls::LsLookup lookup;
-            lookup.reverse_behind = reverse;
-            INFO(scene_name << ", " << kind << " rays, " << s << (reverse ? ", reverse" : "") << (occlusion ? ", occlusion" : ""));
+            lookup.behind = behind;
+            INFO(scene_name << ", " << kind << " rays, " << s << ", " << ls::ls_behind_name(behind) << (occlusion ? ", occlusion" : ""));
             auto trace = [&](lsk::TraceContext& c, const lsk::Ray* r, lsk::Hit* h, size_t n) {
               if (occlusion)
                 a.fast->occluded(c, r, h, n);

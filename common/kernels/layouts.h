@@ -229,7 +229,7 @@ struct ShaderParams {
   uint any_hit;          // trace: stop at the first hit
   uint first;            // trace: first ray of this dispatch
   uint count;            // trace: rays in the buffer
-  uint ls_reverse;       // trace: --ls-behind reverse (ls_lookup.h)
+  uint ls_behind;        // trace: --ls-behind, LS_BEHIND_* (ls_lookup.h)
   uint further_rays;     // candidates: search rays after the midpoint ray
   uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
   uint first_ls;         // candidates: first LS node of this dispatch

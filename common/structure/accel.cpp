@@ -12,6 +12,21 @@ Traversal parse_traversal(const std::string& text) {
 
 const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" : "reference"; }
 
+LsBehind parse_ls_behind(const std::string& text) {
+  for (LsBehind b : {LsBehind::Exact, LsBehind::Empty, LsBehind::Reverse})
+    if (text == ls_behind_name(b)) return b;
+  throw InputError("--ls-behind '" + text + "' is not exact, empty or reverse");
+}
+
+const char* ls_behind_name(LsBehind behind) {
+  switch (behind) {
+    case LsBehind::Empty: return "empty";
+    case LsBehind::Reverse: return "reverse";
+    case LsBehind::Exact: break;
+  }
+  return "exact";
+}
+
 std::vector<ObjectLs> LsPlan::objects(size_t meshes) const {
   std::vector<ObjectLs> objects(meshes);
   for (const LsPlanRow& r : rows) objects[r.mesh] = r.chosen;
@@ -34,6 +49,15 @@ float ls_cos2(const LsLookup& lookup) {
   return lookup.angle_degrees <= 0.0f ? -1.0f : float(std::cos(a) * std::cos(a));
 }
 
+uint32_t ls_behind_code(const LsLookup& lookup) {
+  switch (lookup.behind) {
+    case LsBehind::Empty: return lsk::TraceContext::LS_BEHIND_EMPTY;
+    case LsBehind::Reverse: return lsk::TraceContext::LS_BEHIND_REVERSE;
+    case LsBehind::Exact: break;
+  }
+  return lsk::TraceContext::LS_BEHIND_EXACT;
+}
+
 lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
   lsk::TraceContext c;
   c.nodes = accel.nodes.data();
@@ -49,7 +73,7 @@ lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
     c.ls_records = accel.ls_records.data();
     c.ls_enabled = 1;
     c.ls_cos2 = ls_cos2(lookup);
-    c.ls_reverse = lookup.reverse_behind ? 1u : 0u;
+    c.ls_behind = ls_behind_code(lookup);
     c.ls_skip = lookup.skip == LsSkip::RefusedWalks ? lsk::TraceContext::LS_SKIP_REFUSED_WALKS
                 : lookup.skip == LsSkip::Lookups    ? lsk::TraceContext::LS_SKIP_LOOKUPS
                                                     : 0u;

@@ -61,11 +61,19 @@ struct LsBuildOptions {
 // lookup (each Line Space lane then answers "empty").  The answers are wrong then; nothing else sets it.
 enum class LsSkip { Nothing, RefusedWalks, Lookups };
 
+// What a lookup does where its shaft's first candidate lies behind the ray's origin (--ls-behind;
+// ls_lookup.h): traverse the subtree, let the reverse shaft answer only "empty", or let its
+// candidate answer too.
+enum class LsBehind { Exact, Empty, Reverse };
+
+LsBehind parse_ls_behind(const std::string& text);  // "exact", "empty" or "reverse"; throws InputError
+const char* ls_behind_name(LsBehind behind);
+
 // What a Line Space lookup reads besides the structure: it travels with each trace and render call
 // (trace_rays, RenderOptions::lookup), so changing it never rebuilds a Line Space.
 struct LsLookup {
   float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
-  bool reverse_behind = false;   // --ls-behind reverse: a plane hit behind the origin asks the reverse shaft (ls_lookup.h)
+  LsBehind behind = LsBehind::Exact;  // --ls-behind
   LsSkip skip = LsSkip::Nothing;
 };
 
@@ -192,5 +200,8 @@ lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup = {})
 
 // The kernels' ls_cos2 of a lookup: cos^2 of the refusal angle, negative (refuse all) at 0 degrees.
 float ls_cos2(const LsLookup& lookup);
+
+// The kernels' ls_behind of a lookup: LS_BEHIND_EXACT, _EMPTY or _REVERSE.
+uint32_t ls_behind_code(const LsLookup& lookup);
 
 }  // namespace ls

@@ -78,8 +78,9 @@ struct LsFlags {
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
         ->capture_default_str()->check(CLI::Range(0.0, 90.0));
     app->add_option("--ls-behind", behind,
-                    "a plane hit behind the origin: exact (traverse the subtree) or reverse (the reverse shaft's candidate answers)")
-        ->capture_default_str()->check(CLI::IsMember({"exact", "reverse"}));
+                    "a plane hit behind the origin: exact (traverse the subtree), empty (the reverse shaft may answer "
+                    "\"nothing ahead\", else traverse) or reverse (the reverse shaft's candidate answers)")
+        ->capture_default_str()->check(CLI::IsMember({"exact", "empty", "reverse"}));
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
         ->capture_default_str()->check(CLI::Range(0, 1024));
     app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
@@ -97,7 +98,7 @@ struct LsFlags {
   LsLookup lookup() const {
     LsLookup l;
     l.angle_degrees = float(angle);
-    l.reverse_behind = behind == "reverse";
+    l.behind = parse_ls_behind(behind);
     return l;
   }
   AccelOptions options() const {

@@ -492,7 +492,7 @@ class WideTracer final : public FastTracer {
     uint ls = LS_INVALID;
     uint shaft = 0;
     uint prim_candidate = LS_INVALID;  // the shaft's candidate, read on the turn after parking
-    uint reverse_shaft = 0;  // --ls-behind reverse: loaded too, in case the first candidate's plane hit is behind
+    uint reverse_shaft = 0;  // --ls-behind reverse or empty: loaded too, in case the first candidate's plane hit is behind
     float t_in = 0.0f;
     float t_out = 0.0f;
   };
@@ -531,7 +531,7 @@ class WideTracer final : public FastTracer {
           const lsk::LsNode& node = c.ls_nodes[f.ls];
           f.prim_candidate = c.ls_candidate(node, f.shaft);
           if (f.prim_candidate != LS_INVALID) __builtin_prefetch(&c.ls_records[f.prim_candidate]);
-          if (c.ls_reverse != 0u) {
+          if (c.ls_behind != lsk::TraceContext::LS_BEHIND_EXACT) {
             const uint reverse_prim = c.ls_candidate(node, f.reverse_shaft);
             if (reverse_prim != LS_INVALID) __builtin_prefetch(&c.ls_records[reverse_prim]);
           }
@@ -689,7 +689,7 @@ class WideTracer final : public FastTracer {
     if (!lsk::ls_line_shaft(q.origin, q.dir, q.inv_dir, node.lo, node.hi, node.scale, node.n, f.shaft, f.t_in, f.t_out))
       return false;
     __builtin_prefetch(&c.ls_candidates[c.ls_candidate_word(node, f.shaft)]);
-    if (c.ls_reverse != 0u) {  // the reverse shaft's candidate answers when the first's plane hit is behind tmin
+    if (c.ls_behind != lsk::TraceContext::LS_BEHIND_EXACT) {  // the reverse shaft's candidate answers when the first's plane hit is behind tmin
       f.reverse_shaft = lsk::ls_reverse_shaft(f.shaft, node.n);
       __builtin_prefetch(&c.ls_candidates[c.ls_candidate_word(node, f.reverse_shaft)]);
     }
