@@ -23,6 +23,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <string>
 #include <functional>
 #include <limits>
 #include <map>
@@ -205,6 +206,10 @@ TEST_CASE("wide BVH: same answers with --ls-behind reverse and empty, in either 
         for (const char* s : {"f-ls:4:4", "f-ls:8:6", "2l-ls:2:4", "2l-ls:0:6"}) {
           const ls::Accel a = ls::build_accel(scene, ls::parse_structure(s), options(width));
           for (ls::LsBehind behind : {ls::LsBehind::Reverse, ls::LsBehind::Empty}) {
+            // empty differs from reverse in one line of the shared lookup: one width, one flat and one
+            // two-level structure (the sanitizer builds run this test too).
+            if (behind == ls::LsBehind::Empty && (width != 8 || (std::string(s) != "f-ls:8:6" && std::string(s) != "2l-ls:2:4")))
+              continue;
             ls::LsLookup lookup;
             lookup.behind = behind;
             const std::string what = std::string(scene_name) + ", " + kind + " rays, " + ls::ls_behind_name(behind);
