@@ -1,5 +1,6 @@
 // linespace-cpu end to end: the file formats, the JSON keys of docs/design.md §9, and exit status 2 with a
 // one-line reason on bad input.
+#include "common/base/ray_files.h"
 #include "cpu/trace/embree_tracer.h"
 #include "tests/gltf_writer.h"
 #include "tests/test_helpers.h"
@@ -180,6 +181,49 @@ TEST_CASE("trace --ls-behind reaches the lookup: exact, empty and reverse answer
   CHECK(empty.behind + (empty.empty - exact.empty) == exact.behind);   // the rest refused as behind
   CHECK(reverse.accepted > exact.accepted);
   CHECK(reverse.behind < empty.behind);
+}
+
+TEST_CASE("trace --against counts the rays whose hit differs from another hit file's, and refuses a file of other rays", "[cli]") {
+  fs::create_directories(temp(""));
+  const std::string rays = temp("against.rays").string(), exact = temp("against-exact.hits").string(),
+                    approx = temp("against-ls.hits").string(), short_file = temp("against-short.hits").string();
+  REQUIRE(run("rays --scene builtin:cornell --kind diffuse --count 2000 --seed 4 --out " + rays).status == 0);
+  REQUIRE(run("trace --scene builtin:cornell --structure bvh --rays " + rays + " --hits " + exact).status == 0);
+  auto other_hits = [](const Run& r) {
+    const std::string printed = r.out + r.err;
+    const size_t at = printed.find("against ");
+    REQUIRE(at != std::string::npos);
+    const size_t of = printed.find(": ", at);
+    REQUIRE(of != std::string::npos);
+    unsigned other = 0, total = 0;
+    REQUIRE(std::sscanf(printed.c_str() + of, ": %u of %u rays", &other, &total) == 2);
+    REQUIRE(total == 2000u);
+    return other;
+  };
+  // The approximation against the exact hits: the count the test finds comparing the files itself.
+  const Run traced = run("trace --scene builtin:cornell --structure f-ls:3:3 --ls-min-triangles 0 --rays " + rays + " --hits " +
+                     approx + " --against " + exact);
+  REQUIRE(traced.status == 0);
+  const std::vector<lsk::Hit> a = ls::read_hits(exact), b = ls::read_hits(approx);
+  REQUIRE(a.size() == 2000u);
+  REQUIRE(b.size() == 2000u);
+  unsigned differ = 0;
+  for (size_t i = 0; i < a.size(); ++i) differ += a[i].instance != b[i].instance || a[i].triangle != b[i].triangle;
+  CHECK(differ > 0);
+  CHECK(other_hits(traced) == differ);
+  // The exact structure against itself: none.
+  const Run same = run("trace --scene builtin:cornell --structure bvh --rays " + rays + " --hits " + approx + " --against " + exact);
+  REQUIRE(same.status == 0);
+  CHECK(other_hits(same) == 0u);
+  // A hit file of other rays, or none: exit 2 with one line naming the file.
+  std::vector<lsk::Hit> fewer(a.begin(), a.end() - 1);
+  ls::write_hits(short_file, fewer);
+  for (const std::string& bad : {short_file, temp("no-such.hits").string()}) {
+    const Run r = run("trace --scene builtin:cornell --structure bvh --rays " + rays + " --hits " + approx + " --against " + bad);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find(bad) != std::string::npos);
+  }
 }
 
 TEST_CASE("bench prints DESIGN 9's JSON keys for each structure and Embree, closest hit and occlusion", "[cli]") {

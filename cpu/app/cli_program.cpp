@@ -35,7 +35,7 @@ struct Values {
   std::string structure = "bvh";
   bool json = false;
   LsFlags ls;
-  std::string rays_path, hits_path;
+  std::string rays_path, hits_path, against_path;
   bool any_hit = false;
   std::string kind = "diffuse", out_path;
   size_t count = 1000000;
@@ -90,6 +90,8 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.trace->add_option("--rays", v.rays_path, "ray file (32-byte records)")->required();
   c.trace->add_option("--hits", v.hits_path, "hit file to write (20-byte records)")->required();
   c.trace->add_flag("--any-hit", v.any_hit, "stop at the first hit in [tmin, tmax]");
+  c.trace->add_option("--against", v.against_path,
+                      "a hit file of the same rays (say, the exact BVH's): count the rays whose hit is another triangle");
 
   c.rays = app.add_subcommand("rays", "write a ray file (made on the host)");
   common(c.rays, false);
@@ -251,7 +253,7 @@ void check_budget_flag(const std::vector<StructureSpec>& specs, const Values& v)
 void check_ray_budgets(const Commands& c, const Values& v) {
   const size_t max_memory = v.ls.options().limits.max_memory;
   if (*c.rays) check_ray_budget("rays", "", v.count, 0, max_memory);
-  if (*c.trace) check_ray_budget("trace", v.rays_path, 0, 1, max_memory);
+  if (*c.trace) check_ray_budget("trace", v.rays_path, 0, v.against_path.empty() ? 1 : 2, max_memory);
   if (*c.bench) check_ray_budget("bench", v.rays_path, v.count, 1, max_memory);
 }
 
@@ -287,8 +289,13 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   if (*c.build) {
     backend->print_build(scene, parse_structure(v.structure), v.ls.options(), v.json);
   } else if (*c.trace) {
-    const Accel accel = backend->build(scene, parse_structure(v.structure), v.ls.options());
+    // The files first: bad input is refused before a structure is built.
     const std::vector<lsk::Ray> in = read_rays(v.rays_path);
+    const std::vector<lsk::Hit> against = v.against_path.empty() ? std::vector<lsk::Hit>{} : read_hits(v.against_path);
+    if (!v.against_path.empty() && against.size() != in.size())
+      throw InputError("--against " + v.against_path + " holds " + std::to_string(against.size()) + " hits for " +
+                       std::to_string(in.size()) + " rays: it must be a hit file of the same ray file");
+    const Accel accel = backend->build(scene, parse_structure(v.structure), v.ls.options());
     lsk::LsCounters counters{};
     std::string timing;
     const std::vector<lsk::Hit> out = backend->trace(accel, v.ls.lookup(), in, v.any_hit, &counters, &timing);
@@ -298,6 +305,7 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
     for (const lsk::Hit& h : out) found += h.triangle != lsk::LS_INVALID;
     std::fprintf(stderr, "traced %zu rays with %s%s%s: %zu hits%s; wrote %s\n", in.size(), accel.spec.name().c_str(),
                  device.empty() ? "" : " on ", device.c_str(), found, timing.c_str(), v.hits_path.c_str());
+    if (!v.against_path.empty()) print_other_hits(out, against, v.against_path);
   } else if (*c.render) {
     run_render(scene, v, *backend);
   } else if (*c.bench) {

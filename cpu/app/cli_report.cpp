@@ -113,4 +113,17 @@ void print_counters(const lsk::LsCounters& c) {
                c.refused_angle, c.refused_behind, c.refused_beyond, c.refused_parallel, c.refused_no_shaft);
 }
 
+void print_other_hits(const std::vector<lsk::Hit>& hits, const std::vector<lsk::Hit>& against, const std::string& against_path) {
+  size_t other = 0, missed = 0, extra = 0;
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const bool hit = hits[i].triangle != lsk::LS_INVALID, hit_there = against[i].triangle != lsk::LS_INVALID;
+    other += hits[i].instance != against[i].instance || hits[i].triangle != against[i].triangle;
+    missed += hit_there && !hit;
+    extra += hit && !hit_there;
+  }
+  std::fprintf(stderr, "against %s: %zu of %zu rays (%.2f %%) hit another triangle (%zu miss where it hits, %zu hit where it misses)\n",
+               against_path.c_str(), other, hits.size(), hits.empty() ? 0.0 : 100.0 * double(other) / double(hits.size()), missed,
+               extra);
+}
+
 }  // namespace ls

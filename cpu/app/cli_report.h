@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace ls {
 
@@ -20,5 +21,9 @@ void print_ls_plan(const LsPlan& plan);
 
 // Line Space lookup counters, one line on stderr.
 void print_counters(const lsk::LsCounters& c);
+
+// trace --against: the rays whose hit (instance and triangle, a miss included) differs from another
+// hit file's of the same rays, on stderr.
+void print_other_hits(const std::vector<lsk::Hit>& hits, const std::vector<lsk::Hit>& against, const std::string& against_path);
 
 }  // namespace ls
