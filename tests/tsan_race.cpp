@@ -3,7 +3,8 @@
 // report a real race, and must not report what TBB orders.
 //
 //   tsan_race threads | parallel_for | parallel_reduce | parallel_invoke
-//       two threads (two bodies of one ls:: call) write one int: TSan must report a race here
+//       two threads (two bodies of one ls:: call) write one int, in three rounds: TSan must report a
+//       race here
 //   tsan_race ordered
 //       the caller writes, bodies of each ls:: algorithm read it and write their own results, the
 //       caller reads those: all ordered by TBB, so TSan must report nothing (exit 0)
@@ -74,12 +75,9 @@ int ordered() {
   return out[0] == 20 && out[1] == 22 ? 0 : 1;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const std::string mode = argc == 2 ? argv[1] : "";
+// One racy run of `mode` (false: no such mode): two bodies meet, then both write `shared`.
+bool race_once(const std::string& mode) {
   Meeting m;
-  int status = 0;
   if (mode == "threads") {
     std::thread a([&] { racy_write(m); }), b([&] { racy_write(m); });
     a.join();
@@ -96,11 +94,28 @@ int main(int argc, char** argv) {
         [](int a, int b) { return a + b; });
   } else if (mode == "parallel_invoke") {
     ls::parallel_invoke([&] { racy_write(m); }, [&] { racy_write(m); });
-  } else if (mode == "ordered") {
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string mode = argc == 2 ? argv[1] : "";
+  int status = 0;
+  if (mode == "ordered") {
     status = ordered();
   } else {
-    std::fprintf(stderr, "usage: tsan_race threads|parallel_for|parallel_reduce|parallel_invoke|ordered\n");
-    return 2;
+    // Three rounds: in about 1 run of 100 of the TBB modes, TSan reported no race although the two
+    // bodies met and both wrote (measured; why, not found).  One report is all the test asks for.
+    for (int round = 0; round < 3; ++round) {
+      if (!race_once(mode)) {
+        std::fprintf(stderr, "usage: tsan_race threads|parallel_for|parallel_reduce|parallel_invoke|ordered\n");
+        return 2;
+      }
+    }
   }
   if (alone) {
     std::fprintf(stderr, "tsan_race %s: the bodies never ran on two threads at once\n", mode.c_str());
