@@ -562,6 +562,30 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
   }
 }
 
+TEST_CASE("the names of --ls-behind: each parses to its mode and back, the default first, and another name is refused naming them all", "[line_space]") {
+  const std::vector<std::string> names = ls_behind_names();
+  REQUIRE(names.size() == 3u);
+  CHECK(names.front() == ls_behind_name(LsLookup{}.behind));
+  std::set<int> modes;
+  for (const std::string& name : names) {
+    const LsBehind b = parse_ls_behind(name);
+    CHECK(ls_behind_name(b) == name);
+    modes.insert(int(b));
+    LsLookup l;
+    l.behind = b;
+    modes.insert(100 + int(ls_behind_code(l)));  // distinct kernel codes too
+  }
+  CHECK(modes.size() == 2u * names.size());
+  try {
+    parse_ls_behind("sideways");
+    FAIL("no InputError");
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("sideways") != std::string::npos);
+    for (const std::string& name : names) CHECK(what.find(name) != std::string::npos);
+  }
+}
+
 TEST_CASE("2L-LS stores one Line Space per unique mesh however many instances use it", "[line_space]") {
   std::vector<glm::mat4> many;
   for (int i = 0; i < 64; ++i)

@@ -12,10 +12,23 @@ Traversal parse_traversal(const std::string& text) {
 
 const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" : "reference"; }
 
+namespace {
+constexpr LsBehind kLsBehinds[] = {LsBehind::Exact, LsBehind::Empty, LsBehind::Reverse};
+}  // namespace
+
 LsBehind parse_ls_behind(const std::string& text) {
-  for (LsBehind b : {LsBehind::Exact, LsBehind::Empty, LsBehind::Reverse})
+  std::string names;
+  for (LsBehind b : kLsBehinds) {
     if (text == ls_behind_name(b)) return b;
-  throw InputError("--ls-behind '" + text + "' is not exact, empty or reverse");
+    names += std::string(names.empty() ? "" : ", ") + ls_behind_name(b);
+  }
+  throw InputError("--ls-behind '" + text + "' is not one of " + names);
+}
+
+std::vector<std::string> ls_behind_names() {
+  std::vector<std::string> names;
+  for (LsBehind b : kLsBehinds) names.push_back(ls_behind_name(b));
+  return names;
 }
 
 const char* ls_behind_name(LsBehind behind) {

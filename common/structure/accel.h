@@ -66,8 +66,9 @@ enum class LsSkip { Nothing, RefusedWalks, Lookups };
 // candidate answer too.
 enum class LsBehind { Exact, Empty, Reverse };
 
-LsBehind parse_ls_behind(const std::string& text);  // "exact", "empty" or "reverse"; throws InputError
+LsBehind parse_ls_behind(const std::string& text);  // one of ls_behind_names(); throws InputError
 const char* ls_behind_name(LsBehind behind);
+std::vector<std::string> ls_behind_names();  // every mode's name, the default first (the CLI's choices)
 
 // What a Line Space lookup reads besides the structure: it travels with each trace and render call
 // (trace_rays, RenderOptions::lookup), so changing it never rebuilds a Line Space.

@@ -80,7 +80,7 @@ struct LsFlags {
     app->add_option("--ls-behind", behind,
                     "a plane hit behind the origin: exact (traverse the subtree), empty (the reverse shaft may answer "
                     "\"nothing ahead\", else traverse) or reverse (the reverse shaft's candidate answers)")
-        ->capture_default_str()->check(CLI::IsMember({"exact", "empty", "reverse"}));
+        ->capture_default_str()->check(CLI::IsMember(ls_behind_names()));
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
         ->capture_default_str()->check(CLI::Range(0, 1024));
     app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
