@@ -7,8 +7,8 @@
 #include "cpu/build/build_accel.h"
 #include "cpu/build/line_space_builder.h"
 #include "cpu/trace/exact_wide_bvh.h"
-#include "cpu/trace/ray_generators.h"
 #include "cpu/trace/fast_tracer.h"
+#include "cpu/trace/ray_generators.h"
 #include "cpu/trace/reference_trace.h"
 #include "cpu/trace/trace_rays.h"
 #include "cpu/trace/triangle_blocks.h"
@@ -16,21 +16,21 @@
 #include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
-#include <tbb/global_control.h>
 #include <glm/gtc/matrix_transform.hpp>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <string>
 #include <functional>
 #include <limits>
 #include <map>
 #include <memory>
-#include <set>
 #include <random>
+#include <set>
 #include <sstream>
+#include <string>
 
 // StdRng: the standard distributions.  Meshes carry face normals as vertex normals (the Line Space
 // extrapolates them).
