@@ -392,6 +392,27 @@ TEST_CASE("wide BVH: trace_rays takes the fast path by default and the reference
   CHECK_THROWS_AS(ls::build_accel(scene, ls::parse_structure("bvh"), o), ls::InputError);
 }
 
+TEST_CASE("the names of --traversal: each parses to its traversal and back, the default first, and another name is refused naming them all", "[wide]") {
+  const std::vector<std::string> names = ls::traversal_names();
+  REQUIRE(names.size() == 2u);
+  CHECK(names.front() == ls::traversal_name(ls::AccelOptions{}.traversal));
+  std::set<int> traversals;
+  for (const std::string& name : names) {
+    const ls::Traversal t = ls::parse_traversal(name);
+    CHECK(ls::traversal_name(t) == name);
+    traversals.insert(int(t));
+  }
+  CHECK(traversals.size() == names.size());
+  try {
+    ls::parse_traversal("simd");
+    FAIL("no InputError");
+  } catch (const ls::InputError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("simd") != std::string::npos);
+    for (const std::string& name : names) CHECK(what.find(name) != std::string::npos);
+  }
+}
+
 TEST_CASE("wide BVH: a build without the fast path (the GPU port's) traces with the reference, same hits", "[wide]") {
   const ls::Scene scene = random_scene(5);
   const ls::Accel exact = ls::build_accel(scene, ls::parse_structure("bvh"));

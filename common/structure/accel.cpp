@@ -4,13 +4,26 @@
 
 namespace ls {
 
+namespace {
+constexpr Traversal kTraversals[] = {Traversal::Fast, Traversal::Reference};
+}  // namespace
+
 Traversal parse_traversal(const std::string& text) {
-  if (text == "reference") return Traversal::Reference;
-  if (text == "fast") return Traversal::Fast;
-  throw InputError("traversal '" + text + "' is not reference or fast");
+  std::string names;
+  for (Traversal t : kTraversals) {
+    if (text == traversal_name(t)) return t;
+    names += std::string(names.empty() ? "" : ", ") + traversal_name(t);
+  }
+  throw InputError("traversal '" + text + "' is not one of " + names);
 }
 
 const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" : "reference"; }
+
+std::vector<std::string> traversal_names() {
+  std::vector<std::string> names;
+  for (Traversal t : kTraversals) names.push_back(traversal_name(t));
+  return names;
+}
 
 namespace {
 constexpr LsBehind kLsBehinds[] = {LsBehind::Exact, LsBehind::Empty, LsBehind::Reverse};

@@ -25,8 +25,9 @@ class FastTracer;
 // Which traversal trace_rays uses.
 enum class Traversal { Reference, Fast };
 
-Traversal parse_traversal(const std::string& text);  // "reference" or "fast"; throws InputError
+Traversal parse_traversal(const std::string& text);  // one of traversal_names(); throws InputError
 const char* traversal_name(Traversal t);
+std::vector<std::string> traversal_names();  // every traversal's name, the default first (the CLI's choices)
 
 struct BvhBuildOptions {
   int bins = 32;                 // SAH bins per axis

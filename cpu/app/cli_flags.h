@@ -58,7 +58,7 @@ struct LsFlags {
   double ls_budget_mb = 0.0;
   size_t ls_budget_rays = LsPlanOptions{}.rays;
   bool progress = false;  // a Line Space progress bar on stderr (set when stderr is a terminal)
-  std::string traversal = "fast";
+  std::string traversal = traversal_name(AccelOptions{}.traversal);
   int exact_width = AccelOptions{}.exact_width;
   std::string refused_value;
   std::vector<std::pair<std::string, const CLI::Option*>> refused_flags;  // a program without the fast path: its flags, refused when given
@@ -68,7 +68,7 @@ struct LsFlags {
   void add_to(CLI::App* app, bool fast_path_flags = true) {
     if (fast_path_flags) {
       app->add_option("--traversal", traversal, "fast (wide SIMD BVH) or reference (the scalar kernels, the GPU's twin)")
-          ->capture_default_str()->check(CLI::IsMember({"fast", "reference"}));
+          ->capture_default_str()->check(CLI::IsMember(traversal_names()));
       app->add_option("--exact-width", exact_width, "node width of the fast path's order-free walk: 4 or 8")
           ->capture_default_str()->check(CLI::IsMember({4, 8}));
     } else {  // parsed, then refused by options()
