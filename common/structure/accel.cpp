@@ -5,44 +5,40 @@
 namespace ls {
 
 namespace {
+
 constexpr Traversal kTraversals[] = {Traversal::Fast, Traversal::Reference};
+constexpr LsBehind kLsBehinds[] = {LsBehind::Exact, LsBehind::Empty, LsBehind::Reverse};
+
+// A flag's values by name, listed once (`all`, the default first): the names, and the parse whose
+// error names them all.
+template <class E, size_t N>
+std::vector<std::string> names_of(const E (&all)[N], const char* (*name)(E)) {
+  std::vector<std::string> names;
+  for (E e : all) names.push_back(name(e));
+  return names;
+}
+
+template <class E, size_t N>
+E parse_named(const std::string& text, const E (&all)[N], const char* (*name)(E), const std::string& what) {
+  std::string names;
+  for (E e : all) {
+    if (text == name(e)) return e;
+    names += std::string(names.empty() ? "" : ", ") + name(e);
+  }
+  throw InputError(what + " '" + text + "' is not one of " + names);
+}
+
 }  // namespace
 
-Traversal parse_traversal(const std::string& text) {
-  std::string names;
-  for (Traversal t : kTraversals) {
-    if (text == traversal_name(t)) return t;
-    names += std::string(names.empty() ? "" : ", ") + traversal_name(t);
-  }
-  throw InputError("traversal '" + text + "' is not one of " + names);
-}
+Traversal parse_traversal(const std::string& text) { return parse_named(text, kTraversals, traversal_name, "traversal"); }
 
 const char* traversal_name(Traversal t) { return t == Traversal::Fast ? "fast" : "reference"; }
 
-std::vector<std::string> traversal_names() {
-  std::vector<std::string> names;
-  for (Traversal t : kTraversals) names.push_back(traversal_name(t));
-  return names;
-}
+std::vector<std::string> traversal_names() { return names_of(kTraversals, traversal_name); }
 
-namespace {
-constexpr LsBehind kLsBehinds[] = {LsBehind::Exact, LsBehind::Empty, LsBehind::Reverse};
-}  // namespace
+LsBehind parse_ls_behind(const std::string& text) { return parse_named(text, kLsBehinds, ls_behind_name, "--ls-behind"); }
 
-LsBehind parse_ls_behind(const std::string& text) {
-  std::string names;
-  for (LsBehind b : kLsBehinds) {
-    if (text == ls_behind_name(b)) return b;
-    names += std::string(names.empty() ? "" : ", ") + ls_behind_name(b);
-  }
-  throw InputError("--ls-behind '" + text + "' is not one of " + names);
-}
-
-std::vector<std::string> ls_behind_names() {
-  std::vector<std::string> names;
-  for (LsBehind b : kLsBehinds) names.push_back(ls_behind_name(b));
-  return names;
-}
+std::vector<std::string> ls_behind_names() { return names_of(kLsBehinds, ls_behind_name); }
 
 const char* ls_behind_name(LsBehind behind) {
   switch (behind) {
