@@ -153,7 +153,9 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
   const Scene scene = load_scene(kScene);
   const Accel exact = build_accel(scene, parse_structure("2l-bvh"));
   const size_t fixed = exact.nodes.size() * 4 + exact.tris.size() * sizeof(lsk::LsRecord);
-  const AccelOptions options = with_budget(double(fixed) / 1e6 + 0.8, 6000);
+  AccelOptions options = with_budget(double(fixed) / 1e6 + 0.8, 6000);
+  options.plan.lookup.angle_degrees = 60.0f;  // wide enough that some pilot answers are wrong on this small scene
+  const LsLookup lookup = options.plan.lookup;
   const Accel planned = build_planned_accel(scene, parse_structure("2l-ls:auto"), options);
   const LsPlan& plan = *planned.ls_plan;
   REQUIRE(!plan.reference.empty());
@@ -167,8 +169,8 @@ TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Space
     for (bool any_hit : {false, true}) {
       const std::vector<lsk::Ray>& rays = any_hit ? pilot.shadow_rays : pilot.rays;
       std::vector<lsk::Hit> truth(rays.size()), got(rays.size());
-      trace_rays(exact, LsLookup{}, rays.data(), truth.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
-      trace_rays(a, LsLookup{}, rays.data(), got.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
+      trace_rays(exact, lookup, rays.data(), truth.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
+      trace_rays(a, lookup, rays.data(), got.data(), rays.size(), any_hit, nullptr, Traversal::Reference);
       for (size_t i = 0; i < rays.size(); ++i) wrong += pilot_answer_wrong(rays[i], got[i], truth[i], any_hit, tolerance);
     }
     return wrong;

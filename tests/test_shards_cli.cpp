@@ -84,7 +84,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
   render_ok("--tiles 0:1 --out " + parts.string(), base);
   render_ok("--shard 1/3 --out " + temp("spp").string(), render_args("1", "bvh"));
   render_ok("--shard 1/3 --seed 9 --out " + temp("seed").string(), base);
-  render_ok("--shard 1/3 --ls-angle 30 --out " + temp("angle").string(), base);
+  render_ok("--shard 1/3 --ls-angle 60 --out " + temp("angle").string(), base);  // not the default angle
   render_ok("--shard 1/3 --throughput-switch 0.3:bvh --out " + temp("switch").string(), base);
   render_ok("--shard 1/3 --out " + temp("schedule").string(), render_args("2", "2l-bvh"));
   render_ok("--shard 1/3 --out " + temp("tile").string(), render_args("2", "bvh", "9"));
@@ -117,7 +117,7 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
       {merge + out + s0 + s1 + s1, "tile 1 is in both"},
       {merge + out + s0 + part(temp("spp"), "partial-shard-1-of-3") + s2, "spp is '1'"},
       {merge + out + s0 + part(temp("seed"), "partial-shard-1-of-3") + s2, "seed is '9'"},
-      {merge + out + s0 + part(temp("angle"), "partial-shard-1-of-3") + s2, "ls_flags is 'angle=30"},
+      {merge + out + s0 + part(temp("angle"), "partial-shard-1-of-3") + s2, "ls_flags is 'angle=60"},
       {merge + out + s0 + part(temp("schedule"), "partial-shard-1-of-3") + s2, "schedule is '2l-bvh'"},
       {merge + out + s0 + part(temp("switch"), "partial-shard-1-of-3") + s2, "throughput_switch is '0.3:bvh'"},
       {merge + out + s0 + part(temp("tile"), "partial-shard-1-of-3") + s2, "tile_size is '9'"},

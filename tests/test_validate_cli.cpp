@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 30> cases = {
+  const std::array<std::string, 31> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -34,6 +34,7 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "sweep --depths 0,99",
       "sweep --families bvh",
       "sweep --start-bounce 5 --bounces 3",
+      "sweep --angles 30 --ls-angle 45",  // two flags for one angle
       "paper --tables 5",
       "paper --subdivisions 7",
       "policy --thresholds 0",
@@ -208,6 +209,26 @@ TEST_CASE("linespace-validate sweep writes the data and the trade-off plot", "[c
   }
   REQUIRE(fs::file_size(out / "tradeoff.png") > 1000);
   REQUIRE(fs::file_size(out / "tradeoff.svg") > 1000);
+}
+
+TEST_CASE("linespace-validate sweep without --angles sweeps at --ls-angle", "[cli]") {
+  // At 60 degrees this small sweep errs somewhere; at 0 every lookup is refused and every point is exact.
+  for (const double angle : {60.0, 0.0}) {
+    const fs::path out = temp("sweep-ls-angle");
+    const Run r = validate("sweep --scene builtin:generated:2000:4:1 --depths 3 --subdivisions 3 --ls-angle " +
+                           std::to_string(angle) + " --size 16x16 --spp 1 --bounces 1 --no-plot --out " + out.string());
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(out / "sweep.json"));
+    REQUIRE(j["points"].size() == 2);  // 2 families x 1 depth x 1 subdivision
+    double largest = 0.0;
+    for (const auto& p : j["points"]) {
+      CHECK(p["angle"] == angle);
+      largest = std::max(largest, p["rmse"].get<double>());
+    }
+    if (angle == 0.0) CHECK(largest == 0.0);  // refusing every approximation is exact
+    else CHECK(largest > 0.0);
+  }
 }
 
 TEST_CASE("linespace-validate paper prints the three tables and the claims", "[cli]") {

@@ -160,7 +160,8 @@ int main(int argc, char** argv) {
   ls_flags.add_to(rmse_cmd);
   threads_flag.add_to(rmse_cmd);
 
-  std::string families = "f-ls,2l-ls", depths = "0,2,4,6,8", subdivisions = "4,6,8", angles = "45";
+  std::string families = "f-ls,2l-ls", depths = "0,2,4,6,8", subdivisions = "4,6,8";
+  std::string angles = number_text(LsLookup{}.angle_degrees);  // the lookup's default angle
   int start_bounce = 1;
   bool no_plot = false;
   auto* sweep_cmd = app.add_subcommand("sweep", "MRays/s against RMSE over D, N and the refusal angle; plots the trade-off");
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
   sweep_cmd->add_option("--families", families, "f-ls, 2l-ls or both")->capture_default_str();
   sweep_cmd->add_option("--depths", depths, "integration depths D")->capture_default_str();
   sweep_cmd->add_option("--subdivisions", subdivisions, "subdivisions N")->capture_default_str();
-  sweep_cmd->add_option("--angles", angles, "refusal angles in degrees")->capture_default_str();
+  sweep_cmd->add_option("--angles", angles, "refusal angles in degrees (default: --ls-angle's)")->capture_default_str();
   sweep_cmd->add_option("--start-bounce", start_bounce, "the Line Space traces bounces >= this one")->capture_default_str();
   sweep_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
   sweep_cmd->add_option("--out", out_dir, "folder for sweep.{csv,json,md} and tradeoff.{png,svg}")->default_val("out/sweep");
@@ -289,7 +290,11 @@ int main(int argc, char** argv) {
       grid.families = parse_families(families);
       grid.depths = parse_int_list(depths, "--depths", 0, kMaxLsDepth);
       grid.subdivisions = parse_int_list(subdivisions, "--subdivisions", 1, kMaxLsSubdivision);
-      grid.angles = parse_angle_list(angles);
+      // The angle is --angles' list or --ls-angle's one value (the default of both): never one silently over the other.
+      const bool angles_given = sweep_cmd->get_option("--angles")->count() > 0;
+      if (angles_given && sweep_cmd->get_option("--ls-angle")->count() > 0)
+        throw InputError("sweep: --angles and --ls-angle both set the refusal angle; give one of them");
+      grid.angles = angles_given ? parse_angle_list(angles) : std::vector<float>{image_settings().lookup.angle_degrees};
       grid.start_bounce = start_bounce;
       const ImageSettings settings = image_settings();
       const Scene scene = load_scene(scene_spec);

@@ -19,7 +19,7 @@ struct SweepGrid {
   std::vector<StructureKind> families = {StructureKind::FlatLs, StructureKind::TwoLevelLs};
   std::vector<int> depths = {0, 2, 4, 6, 8};
   std::vector<int> subdivisions = {4, 6, 8};
-  std::vector<float> angles = {45.0f};
+  std::vector<float> angles = {LsLookup{}.angle_degrees};
   int start_bounce = 1;
 };
 

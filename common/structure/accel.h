@@ -74,7 +74,7 @@ std::vector<std::string> ls_behind_names();  // every mode's name, the default f
 // What a Line Space lookup reads besides the structure: it travels with each trace and render call
 // (trace_rays, RenderOptions::lookup), so changing it never rebuilds a Line Space.
 struct LsLookup {
-  float angle_degrees = 45.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all
+  float angle_degrees = 30.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all (30: docs/performance.md)
   LsBehind behind = LsBehind::Exact;  // --ls-behind
   LsSkip skip = LsSkip::Nothing;
 };

@@ -53,7 +53,7 @@ struct LsFlags {
   int further_rays = LsBuildOptions{}.further_rays;
   uint32_t min_triangles = LsBuildOptions{}.min_triangles;
   std::string candidates = "compact";
-  std::string behind = "exact";
+  std::string behind = ls_behind_name(LsLookup{}.behind);
   double max_memory_mb = 0.0;
   double ls_budget_mb = 0.0;
   size_t ls_budget_rays = LsPlanOptions{}.rays;
