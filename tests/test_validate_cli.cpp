@@ -65,14 +65,14 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
 }
 
 TEST_CASE("linespace-validate: bad --spp, --auto-rel-stderr and --auto-seconds exit 2 with a one-line reason", "[cli]") {
-  for (const std::string& c : {"rmse --spp 0", "rmse --spp 65537", "rmse --spp 4x", "rmse --spp automatic", "rmse --spp ''",
-                               "sweep --spp auto --auto-rel-stderr 0", "sweep --spp auto --auto-rel-stderr 1",
-                               "paper --spp auto --auto-rel-stderr -0.1", "budget --spp auto --auto-rel-stderr nan",
-                               "policy --spp auto --auto-seconds 0", "rmse --spp auto --auto-seconds -5",
-                               "rmse --spp 8 --auto-seconds 30", "rmse --auto-rel-stderr 0.2",
-                               "bound --spp auto", "hits --spp auto", "candidates --spp auto"}) {
+  for (const char* c : {"rmse --spp 0", "rmse --spp 65537", "rmse --spp 4x", "rmse --spp automatic", "rmse --spp ''",
+                        "sweep --spp auto --auto-rel-stderr 0", "sweep --spp auto --auto-rel-stderr 1",
+                        "paper --spp auto --auto-rel-stderr -0.1", "budget --spp auto --auto-rel-stderr nan",
+                        "policy --spp auto --auto-seconds 0", "rmse --spp auto --auto-seconds -5",
+                        "rmse --spp 8 --auto-seconds 30", "rmse --auto-rel-stderr 0.2",
+                        "bound --spp auto", "hits --spp auto", "candidates --spp auto"}) {
     INFO(c);
-    const Run r = validate(c + " --out " + temp("unused").string());
+    const Run r = validate(std::string(c) + " --out " + temp("unused").string());
     REQUIRE(r.status == 2);
     REQUIRE(std::count(r.err.begin(), r.err.end(), '\n') == 1);
     REQUIRE(r.err.rfind("linespace-validate: ", 0) == 0);
