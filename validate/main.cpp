@@ -294,9 +294,9 @@ int main(int argc, char** argv) {
       const bool angles_given = sweep_cmd->get_option("--angles")->count() > 0;
       if (angles_given && sweep_cmd->get_option("--ls-angle")->count() > 0)
         throw InputError("sweep: --angles and --ls-angle both set the refusal angle; give one of them");
-      grid.angles = angles_given ? parse_angle_list(angles) : std::vector<float>{image_settings().lookup.angle_degrees};
-      grid.start_bounce = start_bounce;
       const ImageSettings settings = image_settings();
+      grid.angles = angles_given ? parse_angle_list(angles) : std::vector<float>{settings.lookup.angle_degrees};
+      grid.start_bounce = start_bounce;
       const Scene scene = load_scene(scene_spec);
       const AccelOptions accel_options = ls_flags.options();
       auto renderer = make_study_renderer(device, scene, accel_options);
