@@ -176,7 +176,7 @@ TEST_CASE("trace --ls-behind reaches the lookup: exact, empty and reverse answer
   REQUIRE(empty.lookups == 1000u);
   CHECK(exact.behind > 500u);
   CHECK(empty.empty > exact.empty);                                    // the reverse shaft's "nothing ahead"
-  CHECK(empty.empty < reverse.empty);  // some of reverse's: the surface the ray leaves, not one farther or past the box
+  CHECK(empty.empty < reverse.empty);                                  // some of reverse's: the surface the ray leaves
   CHECK(empty.accepted == exact.accepted);                             // its candidates never answer
   CHECK(empty.behind + (empty.empty - exact.empty) == exact.behind);   // the rest refused as behind
   CHECK(reverse.accepted > exact.accepted);
