@@ -44,6 +44,7 @@ lsk::ShaderParams GpuAccel::params(const LsLookup& lookup) const {
   lsk::ShaderParams p = params_;
   p.ls_cos2 = ls_cos2(lookup);  // the CPU's arithmetic, so both sides agree
   p.ls_behind = ls_behind_code(lookup);
+  p.ls_leave_reach = lookup.leave_reach;
   return p;
 }
 

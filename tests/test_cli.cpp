@@ -46,7 +46,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 30> cases = {
+  const std::array<std::string, 33> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -74,6 +74,9 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "build --structure 2l-ls:auto --ls-budget 10 --ls-budget-rays 0",
       "build --exact-width 16",
       "build --ls-behind sideways",
+      "build --ls-leave-reach -1",
+      "trace --ls-leave-reach nan --rays /nonexistent.rays --hits " + temp("h").string(),
+      "build --ls-leave-reach 0.5x",
       "bench --exact-width 0 --count 10",
       "build --threads -1",
       "bench --threads 1048576 --count 10",  // more threads than this process's CPUs
@@ -156,9 +159,8 @@ TEST_CASE("trace --ls-behind reaches the lookup: exact, empty and reverse answer
   struct Counted {
     unsigned lookups = 0, empty = 0, accepted = 0, behind = 0;
   };
-  auto trace = [&](const char* mode) {
-    const Run r = run("trace --scene builtin:cornell --structure f-ls:0:4 --ls-behind " + std::string(mode) + " --rays " + rays +
-                      " --hits " + hits);
+  auto trace = [&](const std::string& mode) {
+    const Run r = run("trace --scene builtin:cornell --structure f-ls:0:4 --ls-behind " + mode + " --rays " + rays + " --hits " + hits);
     REQUIRE(r.status == 0);
     Counted c;
     const std::string printed = r.out + r.err;
@@ -181,6 +183,16 @@ TEST_CASE("trace --ls-behind reaches the lookup: exact, empty and reverse answer
   CHECK(empty.behind + (empty.empty - exact.empty) == exact.behind);   // the rest refused as behind
   CHECK(reverse.accepted > exact.accepted);
   CHECK(reverse.behind < empty.behind);
+  // --ls-leave-reach: the farther off its triangle a reverse plane hit may lie, the more "nothing
+  // ahead" answers; cornell's walls are two triangles each, so some lie on the wall's other one.
+  const Counted on_triangle = trace("empty --ls-leave-reach 0"), in_plane = trace("empty --ls-leave-reach inf");
+  INFO("empty mode at reach 0: " << on_triangle.empty << ", at inf: " << in_plane.empty);
+  CHECK(on_triangle.empty <= empty.empty);
+  CHECK(empty.empty <= in_plane.empty);
+  CHECK(on_triangle.empty < in_plane.empty);
+  CHECK(in_plane.empty < reverse.empty);  // still only the surface the ray leaves
+  CHECK(on_triangle.accepted == exact.accepted);
+  CHECK(in_plane.accepted == exact.accepted);
 }
 
 TEST_CASE("trace --against counts the rays whose hit differs from another hit file's, and refuses a file of other rays", "[cli]") {

@@ -19,6 +19,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <limits>
 #include <memory>
 
 using namespace ls;
@@ -148,7 +149,7 @@ TEST_CASE("GPU hits equal the CPU's bit for bit for all four structures closest 
   for (const char* s : {"bvh", "2l-bvh", "f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random);
 }
 
-TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse and empty", "[gpu]") {
+TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse and empty, at any --ls-leave-reach", "[gpu]") {
   const Scene cornell = load_scene("builtin:cornell");
   const std::vector<lsk::Ray> diffuse = diffuse_rays(cornell, 20000, 3);
   const Scene objects = load_scene("builtin:generated:1200:3:5");
@@ -159,6 +160,14 @@ TEST_CASE("GPU hits equal the CPU's bit for bit with --ls-behind reverse and emp
     lookup.behind = behind;
     for (const char* s : {"f-ls:3:6", "2l-ls:2:6", "2l-ls:0:10"}) require_hits_equal(cornell, s, diffuse, paper(), lookup);
     for (const char* s : {"f-ls:2:10", "2l-ls:1:1"}) require_hits_equal(objects, s, random, paper(), lookup);
+  }
+  for (float reach : {0.0f, std::numeric_limits<float>::infinity()}) {  // the push constant reaches the lookup
+    INFO("empty, leave reach " << reach);
+    LsLookup lookup;
+    lookup.behind = LsBehind::Empty;
+    lookup.leave_reach = reach;
+    require_hits_equal(cornell, "f-ls:3:6", diffuse, paper(), lookup);
+    require_hits_equal(objects, "f-ls:2:10", random, paper(), lookup);
   }
 }
 

@@ -482,6 +482,8 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
     return t;
   };
   auto horizontal = [&](float z) { return plane({-1, -1, z}, {3, -1, z}, {-1, 3, z}); };
+  // A horizontal triangle whose east edge is the line x = east, the rays' plane hits east of it.
+  auto west_of = [&](float east, float z) { return plane({-1, -1, z}, {east, -1, z}, {east, 3, z}); };
   const uint32_t up = 0u, along_x = 0x7fffu;  // octahedral codes of (0, 0, 1) and (1, 0, 0)
   const std::vector<uint32_t> ids = {0, 1}, instances = {0, 0};
   struct Case {
@@ -493,7 +495,8 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
     float tmax;       // as launched
     uint32_t answer;  // with --ls-behind reverse
     uint32_t counter_offset;  // the LsCounters field it counts in
-    bool empty_too = false;   // --ls-behind empty gives the same "empty" (else it refuses as behind)
+    bool empty_too = false;   // --ls-behind empty gives the same "empty" (else it refuses as behind)...
+    float off_patches = 0.0f;  // ...where the plane hit lies at most --ls-leave-reach patches off U
   };
   using C = lsk::TraceContext;
   const glm::vec3 upwards(0.2f, 0.1f, 1.0f);
@@ -504,6 +507,11 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
        offsetof(lsk::LsCounters, empty), true},
       {"within half a patch behind: the surface the ray leaves", horizontal(-0.3f), up, upwards, kInf, kInf, C::LS_EMPTY,
        offsetof(lsk::LsCounters, empty), true},
+      // The plane hit at z = 0.05 lies at x = 0.51; a patch is 0.77.
+      {"0.13 patches outside its triangle: the surface the ray leaves, by default", west_of(0.41f, 0.05f), up, upwards,
+       kInf, kInf, C::LS_EMPTY, offsetof(lsk::LsCounters, empty), true, 0.13f},
+      {"0.39 patches outside its triangle: another surface of its plane, by default", west_of(0.21f, 0.05f), up, upwards,
+       kInf, kInf, C::LS_EMPTY, offsetof(lsk::LsCounters, empty), true, 0.39f},
       {"farther behind: a surface the ray does not leave, which only reverse trusts", horizontal(-0.5f), up, upwards,
        kInf, kInf, C::LS_EMPTY, offsetof(lsk::LsCounters, empty)},
       {"past the box's exit: no surface in the box, which only reverse trusts", horizontal(5.0f), up, upwards, kInf, kInf,
@@ -522,7 +530,13 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
     const std::vector<lsk::Triangle> tris = {horizontal(0.0f), k.u};
     const std::vector<lsk::LsRecord> records = {ls::make_ls_record(tris[0], glm::uvec3(up), 0u),
                                                 ls::make_ls_record(tris[1], glm::uvec3(k.u_normal), 1u)};
-    for (uint32_t behind : {C::LS_BEHIND_EXACT, C::LS_BEHIND_REVERSE, C::LS_BEHIND_EMPTY}) {
+    const float reach = LsLookup{}.leave_reach;
+    REQUIRE(reach == 0.25f);  // the cases' distances straddle it
+    const std::pair<uint32_t, float> settings[] = {{C::LS_BEHIND_EXACT, reach},  {C::LS_BEHIND_REVERSE, reach},
+                                                   {C::LS_BEHIND_EMPTY, reach},  {C::LS_BEHIND_EMPTY, 0.0f},
+                                                   {C::LS_BEHIND_EMPTY, 0.5f},   {C::LS_BEHIND_EMPTY, kInf}};
+    for (const auto& [behind, leave_reach] : settings) {
+      INFO("behind " << behind << ", leave reach " << leave_reach);
       C c;
       c.tris = tris.data();
       c.tri_ids = ids.data();
@@ -532,6 +546,7 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
       c.ls_records = records.data();
       c.ls_cos2 = 0.5f;  // 45 degrees
       c.ls_behind = behind;
+      c.ls_leave_reach = leave_reach;
       const glm::vec3 origin(0.5f, 0.1f, 1e-4f), dir = glm::normalize(k.dir);
       lsk::Hit hit{};
       hit.t = k.current_t;
@@ -544,7 +559,7 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
       std::memcpy(&counted, reinterpret_cast<const char*>(&c.ls_counters) + k.counter_offset, sizeof counted);
       // The documented default: behind the origin, refused; with empty, every answer but the "empty"
       // of an empty reverse shaft or of the surface the ray leaves.
-      if (behind == C::LS_BEHIND_EXACT || (behind == C::LS_BEHIND_EMPTY && !k.empty_too)) {
+      if (behind == C::LS_BEHIND_EXACT || (behind == C::LS_BEHIND_EMPTY && !(k.empty_too && k.off_patches <= leave_reach))) {
         CHECK(answer == C::LS_FALLBACK);
         CHECK(c.ls_counters.refused_behind == 1u);
         CHECK(c.ls_counters.lookups == 1u);

@@ -234,6 +234,7 @@ struct ShaderParams {
   uint search_instance;  // candidates: 0 (2L) or LS_INVALID (F)
   uint first_ls;         // candidates: first LS node of this dispatch
   uint ls_count;         // candidates: LS nodes in this dispatch
+  float ls_leave_reach;  // trace: --ls-leave-reach, patches (ls_lookup.h)
 };
 
 // The push constants of shade.comp (its block's one member `pc`).

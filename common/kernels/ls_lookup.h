@@ -1,8 +1,8 @@
 // The Line Space lookup during traversal (docs/design.md §3), a *context* file like traverse_bvh.h: it reads
 //   ls_nodes[] LsNode, ls_candidates[] uint, ls_records[] LsRecord (a candidate's plane, barycentric
 //   rows, vertex normals and id), tri_instances[], the parameters ls_cos2 (cos^2 of the refusal angle;
-//   negative: refuse everything, empty shafts included) and ls_behind (LS_BEHIND_*: --ls-behind,
-//   below), and the counters ls_counters.  N is the LS node's own (LsNode.n).
+//   negative: refuse everything, empty shafts included), ls_behind (LS_BEHIND_*: --ls-behind, below)
+//   and ls_leave_reach (--ls-leave-reach, below), and the counters ls_counters.  N is the LS node's own (LsNode.n).
 //
 // A lookup's answer is a function of the ray and the node alone, never of the hit found so far, so
 // the closest hit is the same in any visiting order (order-free answers, docs/design.md §3):
@@ -27,9 +27,10 @@
 // so does an empty reverse shaft.  Otherwise outside the window, parallel or past the angle: refused.
 //
 // --ls-behind empty (LS_BEHIND_EMPTY): the reverse shaft answers only "empty", and only where it is
-// empty or its plane hit lies within half a patch of tmin, either side; otherwise (a candidate
-// ahead, farther behind, past the exit, or refused) the lookup is refused as behind.  Measured about
-// as fast as reverse, with less error on the real scenes (docs/performance.md).
+// empty or its plane hit lies within half a patch of tmin, either side, and on the candidate
+// triangle or within ls_leave_reach patches outside it; otherwise (a candidate ahead, farther
+// behind, past the exit, off its triangle, or refused) the lookup is refused as behind.  Measured
+// nearly as fast as reverse, with less error on the real scenes (docs/performance.md).
 
 LS_CONST uint LS_BEHIND_EXACT = 0u;
 LS_CONST uint LS_BEHIND_REVERSE = 1u;
@@ -82,6 +83,36 @@ LS_CONST uint LS_PLANE_BEHIND = 2u;
 LS_CONST uint LS_PLANE_BEYOND = 3u;
 LS_CONST uint LS_PLANE_ANGLE = 4u;
 
+// Barycentric coordinates b1, b2 of the point at t on the ray in the plane of `rec` (b0 = 1 - b1 - b2),
+// outside [0, 1] when it lies off the triangle.
+LS_FN void ls_plane_barycentrics(IN(LsRecord) rec, IN(vec3) origin, IN(vec3) dir, float t, OUT(float) b1, OUT(float) b2) {
+  precise vec3 q = origin + dir * t - rec.p0;
+  b1 = dot_in_order(q, rec.b1);
+  b2 = dot_in_order(q, rec.b2);
+}
+
+// Whether a barycentric weight b lies on its side of the edge, or at most sqrt(reach2) outside: b
+// falls by |grad| a unit of distance.  NaN is outside.
+LS_FN bool ls_within_edge(float b, IN(vec3) grad, float reach2) {
+  precise float b_squared = b * b;
+  precise float limit = reach2 * dot_in_order(grad, grad);
+  return b >= 0.0f || b_squared <= limit;
+}
+
+// Whether the point at t on the ray, in the plane of ls_records[prim], lies on its triangle or at
+// most `reach` (a t distance) outside the line of each edge; the rows b1, b2 are the gradients of
+// their weights, and b0's is minus their sum.
+LS_FN bool ls_plane_point_near_triangle(uint prim, IN(vec3) origin, IN(vec3) dir, float t, float reach) {
+  LsRecord rec = ls_records[prim];
+  float b1;
+  float b2;
+  ls_plane_barycentrics(rec, origin, dir, t, b1, b2);
+  precise float b0 = 1.0f - b1 - b2;
+  precise vec3 g0 = -(rec.b1 + rec.b2);
+  precise float reach2 = reach * reach * dot_in_order(dir, dir);
+  return ls_within_edge(b0, g0, reach2) && ls_within_edge(b1, rec.b1, reach2) && ls_within_edge(b2, rec.b2, reach2);
+}
+
 // The candidate ls_records[prim] as an infinite plane: its hit t in [tmin, tmax] and the
 // barycentrics there, and the refusal angle's test on the vertex normals extrapolated to it.
 LS_FN uint ls_plane_hit(uint prim, IN(vec3) origin, IN(vec3) dir, float tmin, float tmax, OUT(float) t_hit, OUT(float) u_hit,
@@ -96,10 +127,9 @@ LS_FN uint ls_plane_hit(uint prim, IN(vec3) origin, IN(vec3) dir, float tmin, fl
   t_hit = t;
   if (!(t >= tmin)) return LS_PLANE_BEHIND;
   if (!(t <= tmax)) return LS_PLANE_BEYOND;
-  // Barycentric coordinates of the plane hit, outside [0, 1] when it lies off the triangle.
-  precise vec3 q = origin + dir * t - rec.p0;
-  precise float b1 = dot_in_order(q, rec.b1);
-  precise float b2 = dot_in_order(q, rec.b2);
+  float b1;
+  float b2;
+  ls_plane_barycentrics(rec, origin, dir, t, b1, b2);
   precise float b0 = 1.0f - b1 - b2;
   u_hit = b1;
   v_hit = b2;
@@ -151,12 +181,15 @@ LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, flo
     precise float half_patch = 0.5f * ls.inv_n * (t_out - t_in);
     precise float ahead = tmin + half_patch;
     if (prim != LS_INVALID) found = ls_plane_hit(prim, origin, dir, ahead, window_hi, t, u, v);
-    // In empty mode only the surface the ray leaves (a plane hit within half a patch of tmin) and an
-    // empty reverse shaft say "nothing ahead": a last surface farther behind, or past the box's exit,
-    // is one the ray's line does not meet where the shaft's does, and carried rays past a close true
-    // hit (docs/performance.md).
+    // In empty mode only the surface the ray leaves (a plane hit within half a patch of tmin, on the
+    // triangle or within ls_leave_reach patches of it) and an empty reverse shaft say "nothing ahead":
+    // a last surface farther behind, past the box's exit or off its triangle (another surface of its
+    // plane, with something standing between) is one the ray's line does not meet where the shaft's
+    // does, and carried rays past a close true hit (docs/performance.md).
     precise float near_behind = tmin - half_patch;
-    bool leaves = found == LS_PLANE_BEHIND && (ls_behind != LS_BEHIND_EMPTY || t >= near_behind);
+    bool leaves = prim != LS_INVALID && found == LS_PLANE_BEHIND &&
+                  (ls_behind != LS_BEHIND_EMPTY ||
+                   (t >= near_behind && ls_plane_point_near_triangle(prim, origin, dir, t, 2.0f * ls_leave_reach * half_patch)));
     bool past_exit = ls_behind != LS_BEHIND_EMPTY && found != LS_PLANE_PARALLEL && t > t_out;
     if (prim == LS_INVALID || leaves || past_exit) {
       ls_counters.empty += 1u;

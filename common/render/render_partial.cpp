@@ -46,7 +46,7 @@ std::vector<std::pair<std::string, std::string>> render_identity(const PartialHe
 std::string ls_flags_text(const LsBuildOptions& o, const LsLookup& lookup) {
   return "angle=" + float_text(lookup.angle_degrees) + " further_rays=" + std::to_string(o.further_rays) +
          " min_triangles=" + std::to_string(o.min_triangles) + " candidates=" + (o.paper_candidates ? "paper" : "compact") +
-         " behind=" + ls_behind_name(lookup.behind);
+         " behind=" + ls_behind_name(lookup.behind) + " leave_reach=" + float_text(lookup.leave_reach);
 }
 
 std::string partial_stem(const std::string& selection) {

@@ -40,6 +40,19 @@ LsBehind parse_ls_behind(const std::string& text) { return parse_named(text, kLs
 
 std::vector<std::string> ls_behind_names() { return names_of(kLsBehinds, ls_behind_name); }
 
+float parse_ls_leave_reach(const std::string& text) {
+  size_t used = 0;
+  float reach = -1.0f;
+  try {
+    reach = std::stof(text, &used);
+  } catch (const std::exception&) {  // not a number, or out of float's range
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !(reach >= 0.0f))
+    throw InputError("--ls-leave-reach '" + text + "' is not a number of patches >= 0 (inf: anywhere in the candidate's plane)");
+  return reach;
+}
+
 const char* ls_behind_name(LsBehind behind) {
   switch (behind) {
     case LsBehind::Empty: return "empty";
@@ -96,6 +109,7 @@ lsk::TraceContext trace_context(const Accel& accel, const LsLookup& lookup) {
     c.ls_enabled = 1;
     c.ls_cos2 = ls_cos2(lookup);
     c.ls_behind = ls_behind_code(lookup);
+    c.ls_leave_reach = lookup.leave_reach;
     c.ls_skip = lookup.skip == LsSkip::RefusedWalks ? lsk::TraceContext::LS_SKIP_REFUSED_WALKS
                 : lookup.skip == LsSkip::Lookups    ? lsk::TraceContext::LS_SKIP_LOOKUPS
                                                     : 0u;

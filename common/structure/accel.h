@@ -71,11 +71,18 @@ LsBehind parse_ls_behind(const std::string& text);  // one of ls_behind_names();
 const char* ls_behind_name(LsBehind behind);
 std::vector<std::string> ls_behind_names();  // every mode's name, the default first (the CLI's choices)
 
+// --ls-leave-reach: a number of patches >= 0, or inf; throws InputError otherwise.
+float parse_ls_leave_reach(const std::string& text);
+
 // What a Line Space lookup reads besides the structure: it travels with each trace and render call
 // (trace_rays, RenderOptions::lookup), so changing it never rebuilds a Line Space.
 struct LsLookup {
   float angle_degrees = 30.0f;   // refusal angle between ray and extrapolated normal; 0 refuses all (30: docs/performance.md)
   LsBehind behind = LsBehind::Exact;  // --ls-behind
+  // --ls-leave-reach: with --ls-behind empty, how far outside its triangle, in patches, the reverse
+  // candidate's plane hit may lie and still be the surface the ray leaves (ls_lookup.h; inf: anywhere
+  // in its plane).  0.25: the widest that kept livingroom's error under 45 degrees' exact (docs/performance.md).
+  float leave_reach = 0.25f;
   LsSkip skip = LsSkip::Nothing;
 };
 

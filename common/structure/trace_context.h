@@ -27,6 +27,7 @@ struct TraceContext {
   uint ls_enabled = 0;
   float ls_cos2 = -1.0f;
   uint ls_behind = 0;  // --ls-behind: LS_BEHIND_* (ls_lookup.h)
+  float ls_leave_reach = 0.0f;  // --ls-leave-reach: patches (ls_lookup.h)
   uint walk_far_first = 0;  // tests: the farther child first (traverse_bvh.h)
   uint ls_skip = 0;  // linespace-profile --skip, read by the fast path only (LsSkip, accel.h)
   static constexpr uint LS_SKIP_REFUSED_WALKS = 1u;

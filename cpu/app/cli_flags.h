@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,6 +56,11 @@ struct LsFlags {
   uint32_t min_triangles = LsBuildOptions{}.min_triangles;
   std::string candidates = "compact";
   std::string behind = ls_behind_name(LsLookup{}.behind);
+  std::string leave_reach = [] {  // LsLookup{}.leave_reach as text: parse_ls_leave_reach also takes "inf"
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", double(LsLookup{}.leave_reach));
+    return std::string(text);
+  }();
   double max_memory_mb = 0.0;
   double ls_budget_mb = 0.0;
   size_t ls_budget_rays = LsPlanOptions{}.rays;
@@ -81,6 +88,19 @@ struct LsFlags {
                     "a plane hit behind the origin: exact (traverse the subtree), empty (the reverse shaft may answer "
                     "\"nothing ahead\", else traverse) or reverse (the reverse shaft's candidate answers)")
         ->capture_default_str()->check(CLI::IsMember(ls_behind_names()));
+    app->add_option("--ls-leave-reach", leave_reach,
+                    "with --ls-behind empty: how far outside its triangle, in patches, the reverse candidate's plane hit "
+                    "may lie and still be the surface the ray leaves (inf: anywhere in its plane)")
+        ->capture_default_str()
+        ->check([](const std::string& text) {
+          try {
+            parse_ls_leave_reach(text);
+            return std::string();
+          } catch (const InputError& e) {  // CLI11 names the flag itself: from the quoted value on
+            const std::string what = e.what();
+            return what.substr(what.find('\''));
+          }
+        });
     app->add_option("--ls-further-rays", further_rays, "candidate search rays after the midpoint ray")
         ->capture_default_str()->check(CLI::Range(0, 1024));
     app->add_option("--ls-min-triangles", min_triangles, "subtrees with fewer triangles get no Line Space (0: paper)")
@@ -99,6 +119,7 @@ struct LsFlags {
     LsLookup l;
     l.angle_degrees = float(angle);
     l.behind = parse_ls_behind(behind);
+    l.leave_reach = parse_ls_leave_reach(leave_reach);
     return l;
   }
   AccelOptions options() const {

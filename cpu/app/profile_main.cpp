@@ -32,7 +32,8 @@ namespace {
 int usage() {
   std::fprintf(stderr,
                "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
-               "--occlusion | --lookups] [--ls-min-triangles M] [--ls-behind exact|empty|reverse] [--skip refused-walks|lookups] "
+               "--occlusion | --lookups] [--ls-min-triangles M] [--ls-behind exact|empty|reverse] [--ls-leave-reach P] "
+               "[--skip refused-walks|lookups] "
                "[--embree-isa ISA] [--exact-width 4|8]\n");
   return 2;
 }
@@ -58,6 +59,7 @@ int main(int argc, char** argv) try {
     else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
     else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
     else if (a == "--ls-behind" && i + 1 < argc) lookup.behind = ls::parse_ls_behind(argv[++i]);  // else InputError
+    else if (a == "--ls-leave-reach" && i + 1 < argc) lookup.leave_reach = ls::parse_ls_leave_reach(argv[++i]);
     else if (a == "--skip" && i + 1 < argc) {
       const std::string what = argv[++i];
       if (what == "refused-walks") lookup.skip = ls::LsSkip::RefusedWalks;

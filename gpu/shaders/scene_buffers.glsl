@@ -24,6 +24,7 @@ layout(push_constant) uniform Params { ShaderParams pc; };  // common/kernels/la
 uint ls_enabled = pc.ls_enabled;
 float ls_cos2 = pc.ls_cos2;
 uint ls_behind = pc.ls_behind;
+float ls_leave_reach = pc.ls_leave_reach;
 const uint walk_far_first = 0u;  // the CPU's tests' order switch (traverse_bvh.h)
 LsCounters ls_counters;
 void count_work(uint node, uint boxes, uint triangles) {}  // the CPU's work counters (traverse_bvh.h)

@@ -26,8 +26,9 @@ layout(std430, binding = 8) readonly buffer LsCand { uint ls_candidates[]; };
 layout(std430, binding = 9) readonly buffer Records { LsRecord ls_records[]; };
 layout(std430, binding = 10) buffer Rays { Ray rays[]; };
 layout(std430, binding = 11) buffer Hits { Hit hits[]; };
-layout(push_constant) uniform P { uint ls_enabled; uint ls_n; float ls_cos2; uint two_level; uint ls_behind; } pc;
+layout(push_constant) uniform P { uint ls_enabled; uint ls_n; float ls_cos2; uint two_level; uint ls_behind; float ls_leave_reach; } pc;
 uint ls_enabled = pc.ls_enabled; float ls_cos2 = pc.ls_cos2; uint ls_behind = pc.ls_behind;
+float ls_leave_reach = pc.ls_leave_reach;
 const uint walk_far_first = 0u;
 LsCounters ls_counters;
 void count_work(uint node, uint boxes, uint triangles) {}
