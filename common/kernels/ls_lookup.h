@@ -29,8 +29,8 @@
 // --ls-behind empty (LS_BEHIND_EMPTY): the reverse shaft answers only "empty", and only where it is
 // empty or its plane hit lies within half a patch of tmin, either side, and on the candidate
 // triangle or within ls_leave_reach patches outside it; otherwise (a candidate ahead, farther
-// behind, past the exit, off its triangle, or refused) the lookup is refused as behind.  Measured
-// nearly as fast as reverse, with less error on the real scenes (docs/performance.md).
+// behind, past the exit, off its triangle, or refused) the lookup is refused as behind.  Its speed
+// and error beside the other modes, and how the reach was chosen: docs/performance.md.
 
 LS_CONST uint LS_BEHIND_EXACT = 0u;
 LS_CONST uint LS_BEHIND_REVERSE = 1u;
