@@ -2,7 +2,8 @@
 //   ls_nodes[] LsNode, ls_candidates[] uint, ls_records[] LsRecord (a candidate's plane, barycentric
 //   rows, vertex normals and id), tri_instances[], the parameters ls_cos2 (cos^2 of the refusal angle;
 //   negative: refuse everything, empty shafts included), ls_behind (LS_BEHIND_*: --ls-behind, below)
-//   and ls_leave_reach (--ls-leave-reach, below), and the counters ls_counters.  N is the LS node's own (LsNode.n).
+//   and ls_leave_reach (--ls-leave-reach, below), and the counters ls_counters.  N is the LS node's
+//   own (LsNode.n).
 //
 // A lookup's answer is a function of the ray and the node alone, never of the hit found so far, so
 // the closest hit is the same in any visiting order (order-free answers, docs/design.md §3):
