@@ -525,16 +525,16 @@ TEST_CASE("behind the origin with --ls-behind reverse or empty, the lookup decid
       {"an empty reverse shaft (it starts on +X)", horizontal(1.0f), up, glm::vec3(0.5f, 0.0f, 0.6f), kInf, kInf, C::LS_EMPTY,
        offsetof(lsk::LsCounters, empty), true},
   };
+  const float reach = LsLookup{}.leave_reach;
+  REQUIRE(reach == 0.25f);  // the cases' distances straddle it
+  const std::pair<uint32_t, float> settings[] = {{C::LS_BEHIND_EXACT, reach},  {C::LS_BEHIND_REVERSE, reach},
+                                                 {C::LS_BEHIND_EMPTY, reach},  {C::LS_BEHIND_EMPTY, 0.0f},
+                                                 {C::LS_BEHIND_EMPTY, 0.5f},   {C::LS_BEHIND_EMPTY, kInf}};
   for (const Case& k : cases) {
     INFO(k.what);
     const std::vector<lsk::Triangle> tris = {horizontal(0.0f), k.u};
     const std::vector<lsk::LsRecord> records = {ls::make_ls_record(tris[0], glm::uvec3(up), 0u),
                                                 ls::make_ls_record(tris[1], glm::uvec3(k.u_normal), 1u)};
-    const float reach = LsLookup{}.leave_reach;
-    REQUIRE(reach == 0.25f);  // the cases' distances straddle it
-    const std::pair<uint32_t, float> settings[] = {{C::LS_BEHIND_EXACT, reach},  {C::LS_BEHIND_REVERSE, reach},
-                                                   {C::LS_BEHIND_EMPTY, reach},  {C::LS_BEHIND_EMPTY, 0.0f},
-                                                   {C::LS_BEHIND_EMPTY, 0.5f},   {C::LS_BEHIND_EMPTY, kInf}};
     for (const auto& [behind, leave_reach] : settings) {
       INFO("behind " << behind << ", leave reach " << leave_reach);
       C c;
