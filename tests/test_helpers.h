@@ -192,6 +192,29 @@ inline void finish_with_radial_normals(ls::Mesh& mesh) {
   mesh.materials.assign(mesh.triangles.size(), 0u);
 }
 
+// A closed UV sphere: no concave edges, so light samples on a neighbouring facet never sit in a
+// corner (where a light sample's variance is unbounded), and a ray that leaves a facet outwards
+// meets nothing.
+inline ls::Mesh closed_sphere(float radius, int rings, int segments) {
+  ls::Mesh m;
+  m.name = "sphere";
+  for (int r = 0; r <= rings; ++r)
+    for (int g = 0; g < segments; ++g) {
+      const float th = float(M_PI) * float(r) / float(rings), ph = 2.0f * float(M_PI) * float(g) / float(segments);
+      m.positions.push_back(radius * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int g = 0; g < segments; ++g) {
+      const uint32_t a = uint32_t(r * segments + g), b = uint32_t(r * segments + (g + 1) % segments);
+      const uint32_t c = a + uint32_t(segments), d = b + uint32_t(segments);
+      if (r > 0) m.triangles.push_back(glm::uvec3(a, b, d));
+      if (r < rings - 1) m.triangles.push_back(glm::uvec3(a, d, c));
+    }
+  m.materials.assign(m.triangles.size(), 0);
+  for (const glm::vec3& p : m.positions) m.normals.push_back(glm::normalize(p));
+  return m;
+}
+
 // The square [lo, hi]^2 in the z = 0 plane as a grid of cells x cells quads, two triangles each
 // sharing the quad's diagonal (and the grid its vertices); normals (0, 0, 1).
 inline ls::Mesh square_grid(int cells, float lo = -1.0f, float hi = 1.0f, const std::string& name = "") {

@@ -2,12 +2,14 @@
 #include "common/render/render_types.h"
 #include "cpu/build/build_structures.h"
 #include "cpu/render/path_tracer.h"
+#include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
 
 using namespace ls;
+using test_support::closed_sphere;
 
 namespace {
 
@@ -24,28 +26,6 @@ Mesh closed_cube(float half) {
   }
   m.materials.assign(m.triangles.size(), 0);
   m.normals.assign(m.positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
-  return m;
-}
-
-// A closed UV sphere: no concave edges, so light samples on a neighbouring facet never sit in a
-// corner (where a light sample's variance is unbounded).
-Mesh closed_sphere(float radius, int rings, int segments) {
-  Mesh m;
-  m.name = "sphere";
-  for (int r = 0; r <= rings; ++r)
-    for (int g = 0; g < segments; ++g) {
-      const float th = float(M_PI) * float(r) / float(rings), ph = 2.0f * float(M_PI) * float(g) / float(segments);
-      m.positions.push_back(radius * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
-    }
-  for (int r = 0; r < rings; ++r)
-    for (int g = 0; g < segments; ++g) {
-      const uint32_t a = uint32_t(r * segments + g), b = uint32_t(r * segments + (g + 1) % segments);
-      const uint32_t c = a + uint32_t(segments), d = b + uint32_t(segments);
-      if (r > 0) m.triangles.push_back(glm::uvec3(a, b, d));
-      if (r < rings - 1) m.triangles.push_back(glm::uvec3(a, d, c));
-    }
-  m.materials.assign(m.triangles.size(), 0);
-  for (const glm::vec3& p : m.positions) m.normals.push_back(glm::normalize(p));
   return m;
 }
 
