@@ -326,18 +326,79 @@ TEST_CASE("degenerate configurations: flat boxes and D = 0 and D past the leaves
 
 TEST_CASE("Line Space hits respect the ray interval, origins inside LS boxes included", "[line_space]") {
   // Origins inside the soup's LS boxes: a candidate behind the origin must be refused, never reported.
+  // From inside, exact never takes the shaft's first candidate; reverse does, when its plane hit lies
+  // ahead, so it is the mode whose accepted answers from inside are checked here.
   const Scene scene = single_mesh_scene(unit_cube_soup(3000, 17));
   const std::vector<lsk::Ray> rays = interval_rays();
   for (const char* name : {"f-ls:0:4", "f-ls:3:6", "2l-ls:2:3"}) {
     const Accel a = build_accel(scene, parse_structure(name), paper());
-    lsk::LsCounters counters{};
-    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &counters, angle(89.0f));
     INFO(name);
-    CHECK(counters.refused_behind > 0);
-    CHECK(counters.refused_beyond > 0);
-    CHECK(counters.accepted > 0);
+    lsk::LsCounters exact{}, reverse{};
+    const std::vector<lsk::Hit> exact_hits = trace_all(a, rays, false, &exact, angle(89.0f));
+    const std::vector<lsk::Hit> hits = trace_all(a, rays, false, &reverse, angle(89.0f, LsBehind::Reverse));
+    CHECK(exact.refused_behind > 0);
+    CHECK(reverse.refused_beyond > 0);
+    CHECK(reverse.accepted > 0);
+    CHECK(require_in_interval(exact_hits, rays) > 0);
     CHECK(require_in_interval(hits, rays) > 0);
-    require_in_interval(trace_all(a, rays, true, nullptr, angle(89.0f)), rays);  // any-hit answers stay inside the interval too
+    for (const LsLookup& lookup : {angle(89.0f), angle(89.0f, LsBehind::Reverse)})  // any-hit answers stay inside the interval too
+      require_in_interval(trace_all(a, rays, true, nullptr, lookup), rays);
+  }
+}
+
+TEST_CASE("from inside an LS box exact and empty never take the first candidate, so rays leaving a sphere keep off its neighbouring facets", "[line_space]") {
+  // A closed sphere is convex: a ray that leaves one of its facets outwards (from just off it, within
+  // 40 degrees of its normal) meets nothing.  Seen from such an origin, the shaft's first candidate
+  // lies behind it or is a facet beside the one it leaves, whose plane it crosses just ahead.
+  const Scene scene = single_mesh_scene(closed_sphere(1.0f, 24, 48));
+  const Mesh& mesh = scene.meshes[0];
+  std::mt19937 rng(31);
+  std::vector<lsk::Ray> leaving;
+  while (leaving.size() < 20000) {
+    const glm::uvec3 t = mesh.triangles[rng() % mesh.triangles.size()];
+    const glm::vec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    const float u = uniform(rng), v = uniform(rng);
+    if (u + v > 1.0f) continue;
+    const glm::vec3 d = glm::normalize(glm::vec3(uniform(rng), uniform(rng), uniform(rng)) * 2.0f - 1.0f);
+    const glm::vec3 dir = glm::normalize(n + 0.8f * d);
+    if (glm::dot(dir, n) < std::cos(glm::radians(40.0f))) continue;
+    leaving.push_back(make_ray(a + u * (b - a) + v * (c - a) + 1e-4f * n, dir));
+  }
+  const std::vector<lsk::Hit> bvh = trace_all(build_accel(scene, parse_structure("bvh"), paper()), leaving);
+  for (const lsk::Hit& h : bvh) REQUIRE(h.triangle == lsk::LS_INVALID);
+  // Rays from outside the sphere's bounds at it, so that exact mode's acceptances are still seen.
+  std::vector<lsk::Ray> towards;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 o(0.3f * uniform(rng) - 0.15f, 0.3f * uniform(rng) - 0.15f, 3.0f);
+    towards.push_back(make_ray(o, glm::normalize(-o)));
+  }
+  // Boxes of a few dozen facets, so that most of a leaving ray's lookups are from inside one.
+  for (const char* name : {"f-ls:3:6", "f-ls:5:6", "2l-ls:2:6"}) {
+    INFO(name);
+    const Accel a = build_accel(scene, parse_structure(name), paper());
+    auto false_hits = [&](const LsLookup& lookup, lsk::LsCounters& counters) {
+      size_t n = 0;
+      for (const lsk::Hit& h : trace_all(a, leaving, false, &counters, lookup)) n += h.triangle != lsk::LS_INVALID;
+      return n;
+    };
+    // reverse keeps the first candidate's answer from inside: its false hits show that these rays
+    // meet the case.
+    lsk::LsCounters reverse{};
+    const size_t reverse_false = false_hits(angle(60.0f, LsBehind::Reverse), reverse);
+    CHECK(reverse_false > leaving.size() / 10);
+    for (LsBehind behind : {LsBehind::Exact, LsBehind::Empty}) {
+      INFO(ls_behind_name(behind));
+      // What is left is the infinite plane's error on lookups from outside a box the ray passes
+      // through: under a hundredth of reverse's.
+      lsk::LsCounters counters{};
+      CHECK(false_hits(angle(60.0f, behind), counters) * 100 < reverse_false);
+      CHECK(counters.accepted * 100 < reverse.accepted);
+      CHECK(counters.refused_behind > 0);
+      lsk::LsCounters outside{};
+      trace_all(a, towards, false, &outside, angle(60.0f, behind));
+      CHECK(outside.accepted > 0);
+    }
   }
 }
 
@@ -359,14 +420,20 @@ TEST_CASE("Line Space hits respect the ray interval with --ls-behind reverse and
     // The behind refusals became answers: more accepted or empty, the same lookups before them.
     CHECK(reverse_counters.accepted + reverse_counters.empty > exact_counters.accepted + exact_counters.empty);
     // empty: some of reverse's "nothing ahead" answers (those of the surface the ray leaves and of an
-    // empty reverse shaft), and every other behind lookup refused as in exact mode.  Exactly so where
-    // a ray makes one lookup (the root's); elsewhere the answers change which nodes a ray reaches.
+    // empty reverse shaft), and every other behind lookup refused as in exact mode.  From inside the
+    // box exact refuses every shaft that is not empty as behind, without reading its candidate, where
+    // empty names the reason (angle, past the window, parallel).  Exactly so where a ray makes one
+    // lookup (the root's); elsewhere the answers change which nodes a ray reaches.
     if (std::string(name) == "f-ls:0:4") {
       CHECK(empty_counters.lookups == exact_counters.lookups);
       CHECK(empty_counters.empty <= reverse_counters.empty);
       CHECK(empty_counters.accepted == exact_counters.accepted);
-      CHECK(empty_counters.refused_behind + (empty_counters.empty - exact_counters.empty) == exact_counters.refused_behind);
-      CHECK(empty_counters.refused_angle == exact_counters.refused_angle);
+      CHECK(empty_counters.refused_no_shaft == exact_counters.refused_no_shaft);
+      CHECK(empty_counters.refused_angle >= exact_counters.refused_angle);
+      CHECK(empty_counters.refused_behind + empty_counters.refused_angle + empty_counters.refused_beyond +
+                empty_counters.refused_parallel + (empty_counters.empty - exact_counters.empty) ==
+            exact_counters.refused_behind + exact_counters.refused_angle + exact_counters.refused_beyond +
+                exact_counters.refused_parallel);
     }
     CHECK(empty_counters.empty > exact_counters.empty);
     CHECK(empty_counters.refused_behind < exact_counters.refused_behind);

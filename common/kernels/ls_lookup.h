@@ -17,6 +17,9 @@
 // parallel to the plane, when the plane hit lies outside the window (before the box or tmin, past
 // the box or tmax), when the line runs along a face of the box (no shaft), or when the angle between
 // the ray and the candidate's vertex normals extrapolated to the plane hit exceeds the refusal angle.
+// With --ls-behind exact or empty, a ray whose line enters the LS box before tmin (an origin inside
+// it) is never answered by the shaft's first candidate: only "empty" (exact: an empty shaft; empty:
+// below) answers it, and the rest is refused as behind.
 //
 // --ls-behind reverse (LS_BEHIND_REVERSE): a plane hit behind the origin (before tmin) is not refused.  The
 // shaft's candidate is the first surface its line meets from the start patch; the *reverse* shaft's
@@ -170,6 +173,16 @@ LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, flo
     ls_counters.empty += 1u;
     return LS_EMPTY;
   }
+  // The line enters the LS box before tmin (an origin inside it): the shaft's first surface, met from
+  // its start patch, is rarely one ahead of the ray.  It lies behind, or its plane is crossed just
+  // ahead by a ray that leaves a neighbouring facet of a curved surface (a false hit at once).  So
+  // from inside, exact answers only an empty shaft and reads no record; empty asks the reverse shaft
+  // as below when the plane hit is behind, and refuses the rest (docs/performance.md).
+  bool inside = t_in < tmin && ls_behind != LS_BEHIND_REVERSE;
+  if (inside && ls_behind == LS_BEHIND_EXACT) {
+    ls_counters.refused_behind += 1u;
+    return LS_FALLBACK;
+  }
   float window_lo;
   float window_hi;
   ls_window(origin, inv_dir, box_lo, box_hi, tmin, tmax, window_lo, window_hi);
@@ -177,6 +190,7 @@ LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, flo
   float u;
   float v;
   uint found = ls_plane_hit(prim, origin, dir, window_lo, window_hi, t, u, v);
+  if (inside && found == LS_PLANE_HIT) found = LS_PLANE_BEHIND;
   if (found == LS_PLANE_BEHIND && ls_behind != LS_BEHIND_EXACT && t < tmin) {
     prim = ls_candidate(ls, ls_reverse_shaft(shaft, ls.n));
     precise float half_patch = 0.5f * ls.inv_n * (t_out - t_in);
