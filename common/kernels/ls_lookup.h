@@ -162,6 +162,11 @@ LS_FN void ls_window(IN(vec3) origin, IN(vec3) inv_dir, IN(vec3) box_lo, IN(vec3
   window_hi = min(hi, tmax);
 }
 
+// Whether a lookup whose line enters the LS box at t_in reads its first candidate's record: not in
+// exact mode from inside the box (t_in before tmin), where only an empty shaft answers
+// (ls_shaft_lookup; a caller that prefetches the record asks the same).
+LS_FN bool ls_reads_first_record(float t_in, float tmin) { return ls_behind != LS_BEHIND_EXACT || !(t_in < tmin); }
+
 // ls_lookup once the ray's line is known to cross shaft `shaft` of `ls`, entering and leaving the
 // LS box at t_in and t_out (ls_line_shaft), and its candidate `prim` is read (ls_candidate): what a
 // caller that loads the shaft ahead of time runs.
@@ -178,8 +183,7 @@ LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, flo
   // ahead by a ray that leaves a neighbouring facet of a curved surface (a false hit at once).  So
   // from inside, exact answers only an empty shaft and reads no record; empty asks the reverse shaft
   // as below when the plane hit is behind, and refuses the rest (docs/performance.md).
-  bool inside = t_in < tmin && ls_behind != LS_BEHIND_REVERSE;
-  if (inside && ls_behind == LS_BEHIND_EXACT) {
+  if (!ls_reads_first_record(t_in, tmin)) {
     ls_counters.refused_behind += 1u;
     return LS_FALLBACK;
   }
@@ -190,7 +194,7 @@ LS_FN uint ls_shaft_lookup(IN(LsNode) ls, uint shaft, uint prim, float t_in, flo
   float u;
   float v;
   uint found = ls_plane_hit(prim, origin, dir, window_lo, window_hi, t, u, v);
-  if (inside && found == LS_PLANE_HIT) found = LS_PLANE_BEHIND;
+  if (ls_behind == LS_BEHIND_EMPTY && t_in < tmin && found == LS_PLANE_HIT) found = LS_PLANE_BEHIND;
   if (found == LS_PLANE_BEHIND && ls_behind != LS_BEHIND_EXACT && t < tmin) {
     prim = ls_candidate(ls, ls_reverse_shaft(shaft, ls.n));
     precise float half_patch = 0.5f * ls.inv_n * (t_out - t_in);

@@ -530,9 +530,8 @@ class WideTracer final : public FastTracer {
         if (f.phase == Phase::Word) {
           const lsk::LsNode& node = c.ls_nodes[f.ls];
           f.prim_candidate = c.ls_candidate(node, f.shaft);
-          // From inside the LS box exact mode reads no record (ls_shaft_lookup).
-          const bool reads_record = c.ls_behind != lsk::TraceContext::LS_BEHIND_EXACT || !(f.t_in < f.q->tmin);
-          if (f.prim_candidate != LS_INVALID && reads_record) __builtin_prefetch(&c.ls_records[f.prim_candidate]);
+          if (f.prim_candidate != LS_INVALID && c.ls_reads_first_record(f.t_in, f.q->tmin))
+            __builtin_prefetch(&c.ls_records[f.prim_candidate]);
           if (c.ls_behind != lsk::TraceContext::LS_BEHIND_EXACT) {
             const uint reverse_prim = c.ls_candidate(node, f.reverse_shaft);
             if (reverse_prim != LS_INVALID) __builtin_prefetch(&c.ls_records[reverse_prim]);
