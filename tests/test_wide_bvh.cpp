@@ -526,6 +526,28 @@ float float_with_field(StdRng& rng, uint32_t field) {
   return std::bit_cast<float>((rng.gen() % 2 ? 0x80000000u : 0u) | field << 23 | mantissa);
 }
 
+TEST_CASE("the kernels' abs clears the sign bit, as GPUs compile GLSL's: signed zeros and NaNs of either sign, every exponent", "[wide]") {
+  // glm's x >= 0 ? x : -x would keep -0 and flip a NaN's sign (and compiled to a mispredicted jump).
+  StdRng rng(29);
+  size_t checked = 0, mismatches = 0;
+  auto check = [&](float x) {
+    ++checked;
+    const uint32_t want = std::bit_cast<uint32_t>(x) & 0x7FFFFFFFu;
+    if (std::bit_cast<uint32_t>(lsk::abs(x)) != want && mismatches++ < 5)
+      UNSCOPED_INFO("x bits " << std::hex << std::bit_cast<uint32_t>(x));
+  };
+  for (uint32_t field = 0; field < 256; ++field)  // field 255: infinities and NaNs with random payloads
+    for (int k = 0; k < 2000; ++k) check(float_with_field(rng, field));
+  for (float x : {0.0f, -0.0f, kInf, -kInf, std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::quiet_NaN(),
+                  std::numeric_limits<float>::denorm_min(), -std::numeric_limits<float>::denorm_min()})
+    check(x);
+  const glm::vec3 v(-0.0f, -std::numeric_limits<float>::quiet_NaN(), -2.5f);
+  const glm::vec3 got = lsk::abs(v);
+  for (int a = 0; a < 3; ++a) CHECK(std::bit_cast<uint32_t>(got[a]) == (std::bit_cast<uint32_t>(v[a]) & 0x7FFFFFFFu));
+  CHECK(checked == 256u * 2000u + 8u);
+  CHECK(mismatches == 0);
+}
+
 TEST_CASE("make_block_ray's triangle ray is the kernel's make_tri_ray, bit for bit", "[wide]") {
   // Directions whose components have every exponent field (zero, denormal, normal, huge, inf, NaN),
   // either sign, ties between their magnitudes (the axis choice) and -0.
