@@ -67,9 +67,12 @@ LS_ALWAYS_INLINE void init_slab_ray(SlabRay<Batch>& r, const vec3& origin, const
     r.inv_dir[a] = Batch(inv[a]);
     r.lo[a] = uint32_t(offsetof(Node, lo)) + row * uint32_t(a);
     r.hi[a] = uint32_t(offsetof(Node, hi)) + row * uint32_t(a);
-    const bool ascending = inv[a] >= 0.0f;
-    r.enter[a] = ascending ? r.lo[a] : r.hi[a];
-    r.leave[a] = ascending ? r.hi[a] : r.lo[a];
+    // The rows by arithmetic on the sign, not a branch: GCC made the choice a jump in the Line Space
+    // tracer, which rays of random direction signs mispredicted 1.4 times a ray (fireplace).
+    const uint32_t descending = uint32_t(!(inv[a] >= 0.0f));
+    const uint32_t swap = descending * (r.hi[a] - r.lo[a]);
+    r.enter[a] = r.lo[a] + swap;
+    r.leave[a] = r.hi[a] - swap;
     r.parallel[a] = std::abs(inv[a]) == big;
   }
   r.any_parallel = r.parallel[0] || r.parallel[1] || r.parallel[2];
