@@ -114,12 +114,6 @@ LS_ALWAYS_INLINE void slab_tests(const char* rows, const SlabRay<Batch>& r, cons
                        Batch(lsk::LS_WIDEN_SLACK);
 }
 
-// lsk::widen_distance with |t| taken by clearing the sign bit: one instruction, where the kernels'
-// abs (glm's value: -0 kept, a NaN's sign flipped) takes six, and glm's own is a branch, which a
-// walk's pops mispredicted about once a ray.  The two differ only in the sign of a zero or a NaN,
-// which no comparison sees.
-LS_ALWAYS_INLINE float widen_limit(float t) { return t + std::fabs(t) * lsk::LS_WIDEN_SLACK; }
-
 // The batch an exact W-wide node's boxes are tested in: 4 floats, or 8 where the build has AVX and
 // W = 8 (an 8-wide node on SSE2 takes two batches).
 template <int W>
@@ -178,7 +172,7 @@ struct ExactWalk {
 
   // The nearest pending child that can still hold something as close as a hit at t; false: none.
   bool pop(float t) {
-    const float limit = widen_limit(t);
+    const float limit = lsk::widen_distance(t);
     while (sp > 0) {
       --sp;
       if (stack[sp].t <= limit) {
