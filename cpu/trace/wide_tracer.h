@@ -464,7 +464,8 @@ class WideTracer final : public FastTracer {
   // makes about one lookup, so one ray alone has nothing to overlap them with.  kInFlight rays walk
   // in turn instead: a walk that reaches a Line Space lane computes its shaft, starts loading the
   // word and parks; on its next turn it reads the word and starts loading the record; on the turn
-  // after it runs the lookup on loaded lines and walks on.  The answers are order-free, so every
+  // after it runs the lookup on loaded lines and walks on.  A lookup that reads no record lands on
+  // the turn that reads the word.  The answers are order-free, so every
   // ray gets the hit (and the counters) it gets alone.
   static constexpr int kInFlight = 8;
   enum class Phase { Free, Word, Record };
@@ -527,24 +528,30 @@ class WideTracer final : public FastTracer {
     }
     while (live > 0) {
       for (Flight& f : flights) {
-        if (f.phase == Phase::Word) {
-          const lsk::LsNode& node = c.ls_nodes[f.ls];
-          f.prim_candidate = c.ls_candidate(node, f.shaft);
-          if (f.prim_candidate != LS_INVALID && c.ls_reads_first_record(f.t_in, f.q->tmin))
-            __builtin_prefetch(&c.ls_records[f.prim_candidate]);
-          if (c.ls_behind != lsk::TraceContext::LS_BEHIND_EXACT) {
-            const uint reverse_prim = c.ls_candidate(node, f.reverse_shaft);
-            if (reverse_prim != LS_INVALID) __builtin_prefetch(&c.ls_records[reverse_prim]);
-          }
-          f.phase = Phase::Record;
-        } else if (f.phase == Phase::Record) {
-          if (land(c, f)) continue;
-          hits[f.index] = lsk::finish_hit(f.hit);
-          launch(f);
-          live -= f.phase == Phase::Free;
-        }
+        if (f.phase == Phase::Free || (f.phase == Phase::Word && load_record(c, f))) continue;
+        if (land(c, f)) continue;
+        hits[f.index] = lsk::finish_hit(f.hit);
+        launch(f);
+        live -= f.phase == Phase::Free;
       }
     }
+  }
+
+  // f's turn at Phase::Word: reads its shaft's candidate word.  True when the lookup needs the
+  // candidate's record (and the reverse shaft's, with --ls-behind reverse or empty): they start
+  // loading and f lands on its next turn.  False when it needs none, an empty shaft or, in exact mode,
+  // a line that enters the box before tmin: f lands at once.
+  bool load_record(lsk::TraceContext& c, Flight& f) const {
+    const lsk::LsNode& node = c.ls_nodes[f.ls];
+    f.prim_candidate = c.ls_candidate(node, f.shaft);
+    if (f.prim_candidate == LS_INVALID || !c.ls_reads_first_record(f.t_in, f.q->tmin)) return false;
+    __builtin_prefetch(&c.ls_records[f.prim_candidate]);
+    if (c.ls_behind != lsk::TraceContext::LS_BEHIND_EXACT) {
+      const uint reverse_prim = c.ls_candidate(node, f.reverse_shaft);
+      if (reverse_prim != LS_INVALID) __builtin_prefetch(&c.ls_records[reverse_prim]);
+    }
+    f.phase = Phase::Record;
+    return true;
   }
 
   // The first turn of a flat structure's ray: true when it parks.
