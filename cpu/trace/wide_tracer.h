@@ -465,8 +465,8 @@ class WideTracer final : public FastTracer {
   // in turn instead: a walk that reaches a Line Space lane computes its shaft, starts loading the
   // word and parks; on its next turn it reads the word and starts loading the record; on the turn
   // after it runs the lookup on loaded lines and walks on.  A lookup that reads no record lands on
-  // the turn that reads the word.  The answers are order-free, so every
-  // ray gets the hit (and the counters) it gets alone.
+  // the turn that reads the word.  The answers are order-free, so every ray gets the hit (and the
+  // counters) it gets alone.
   static constexpr int kInFlight = 8;
   enum class Phase { Free, Word, Record };
   struct Flight {
