@@ -144,6 +144,52 @@ TEST_CASE("the heat-map's per-pixel errors give back the RMSE", "[validate]") {
   REQUIRE_THROWS_AS(pixel_errors(a, Image{11, 19, b.pixels}, e), InputError);
 }
 
+TEST_CASE("a sweep over the smallest subtree and the behind mode measures each point as its own run would", "[validate]") {
+  const Scene scene = load_scene("builtin:cornell");
+  const ImageSettings settings = tiny_image();
+  SweepGrid grid;
+  grid.families = {StructureKind::FlatLs, StructureKind::TwoLevelLs};
+  grid.depths = {2};
+  grid.subdivisions = {4};
+  grid.behinds = {LsBehind::Exact, LsBehind::Reverse};
+  grid.min_triangles = {0, 1u << 30};  // every subtree, then none: no Line Space at all
+  StudyRenderer sweeping(make_cpu_backend(), scene, AccelOptions{});
+  const Sweep sweep = run_sweep(sweeping, "builtin:cornell", grid, settings, quiet);
+  REQUIRE(sweep.points.size() == 8);
+  size_t i = 0;
+  for (uint32_t min_triangles : grid.min_triangles)
+    for (LsBehind behind : grid.behinds)
+      for (const char* structure : {"f-ls:2:4", "2l-ls:2:4"}) {
+        const SweepPoint& p = sweep.points[i++];
+        INFO(structure << " " << ls_behind_name(behind) << " min-triangles " << min_triangles);
+        REQUIRE(p.structure == structure);
+        REQUIRE(p.behind == behind);
+        REQUIRE(p.min_triangles == min_triangles);
+        REQUIRE(p.refused.empty());
+        // A renderer of its own, built with this smallest subtree and traced with this mode.
+        AccelOptions options;
+        options.ls.min_triangles = min_triangles;
+        StudyRenderer alone(make_cpu_backend(), scene, options);
+        ImageSettings lookup = settings;
+        lookup.lookup.behind = behind;
+        Reference reference = render_reference(alone, lookup);
+        const Measured m = measure(alone, schedule_from(parse_structure(structure), 1), lookup, reference);
+        REQUIRE(p.ls_nodes == alone.structure(parse_structure(structure)).ls_info.ls_nodes);
+        REQUIRE(p.rmse == m.rmse);
+        REQUIRE(p.bias.rmse_bias == m.bias.rmse_bias);
+        if (min_triangles == 0) {
+          REQUIRE(p.ls_nodes > 0);
+          REQUIRE(p.rmse > 0.0);  // the Line Space is in use, or the equalities above prove little
+        } else {
+          REQUIRE(p.ls_nodes == 0);
+          REQUIRE(p.rmse == 0.0);  // no Line Space: the exact BVH's image
+        }
+      }
+  REQUIRE(i == sweep.points.size());
+  // The modes answer differently somewhere, or the behind axis would not be tested.
+  REQUIRE(sweep.points[0].rmse != sweep.points[2].rmse);
+}
+
 TEST_CASE("the Pareto front is exactly the points no other point dominates", "[validate]") {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -183,6 +229,10 @@ TEST_CASE("list flags of the validator reject nonsense", "[validate]") {
   REQUIRE_THROWS_AS(parse_angle_list("91"), InputError);
   REQUIRE_THROWS_AS(parse_angle_list("nan"), InputError);
   REQUIRE_THROWS_AS(parse_families("f-ls,bvh"), InputError);
+  REQUIRE(parse_behind_list("reverse,exact") == std::vector<LsBehind>{LsBehind::Reverse, LsBehind::Exact});
+  REQUIRE_THROWS_AS(parse_behind_list("exact,ahead"), InputError);
+  REQUIRE(parse_min_triangles_list("0,512") == std::vector<uint32_t>{0, 512});
+  REQUIRE_THROWS_AS(parse_min_triangles_list("-1"), InputError);
 }
 
 TEST_CASE("interpolation on the policy curves: linear between neighbours, none outside", "[validate]") {

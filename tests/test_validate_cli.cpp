@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 31> cases = {
+  const std::array<std::string, 35> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -35,6 +35,10 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "sweep --families bvh",
       "sweep --start-bounce 5 --bounces 3",
       "sweep --angles 30 --ls-angle 45",  // two flags for one angle
+      "sweep --behinds exact --ls-behind reverse",
+      "sweep --behinds exact,ahead",
+      "sweep --min-triangles 8 --ls-min-triangles 0",
+      "sweep --min-triangles 8,x",
       "paper --tables 5",
       "paper --subdivisions 7",
       "policy --thresholds 0",
@@ -209,6 +213,32 @@ TEST_CASE("linespace-validate sweep writes the data and the trade-off plot", "[c
   }
   REQUIRE(fs::file_size(out / "tradeoff.png") > 1000);
   REQUIRE(fs::file_size(out / "tradeoff.svg") > 1000);
+}
+
+TEST_CASE("linespace-validate sweep over the behind mode and the smallest subtree", "[cli]") {
+  const fs::path out = temp("sweep-behinds");
+  const Run r = validate("sweep --scene builtin:generated:2000:4:1 --families f-ls --depths 3 --subdivisions 3 "
+                         "--behinds exact,reverse --min-triangles 0,1000000 --ls-angle 60 --size 16x16 --spp 1 "
+                         "--bounces 1 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "sweep.json"));
+  REQUIRE(j["points"].size() == 4);  // 2 smallest subtrees x 2 modes
+  const std::vector<std::pair<int, std::string>> order = {{0, "exact"}, {0, "reverse"}, {1000000, "exact"}, {1000000, "reverse"}};
+  for (size_t i = 0; i < order.size(); ++i) {
+    const auto& p = j["points"][i];
+    INFO(p.dump());
+    REQUIRE(p["min_triangles"] == order[i].first);
+    REQUIRE(p["behind"] == order[i].second);
+    if (order[i].first == 0) {
+      REQUIRE(p["ls_nodes"].get<int>() > 0);
+    } else {  // no subtree is that large: no Line Space, the exact image
+      REQUIRE(p["ls_nodes"] == 0);
+      REQUIRE(p["rmse"] == 0.0);
+    }
+  }
+  REQUIRE(fs::file_size(out / "tradeoff.png") > 1000);
+  REQUIRE(slurp(out / "sweep.csv").find("behind,min_triangles") != std::string::npos);
 }
 
 TEST_CASE("linespace-validate sweep without --angles sweeps at --ls-angle", "[cli]") {

@@ -162,14 +162,22 @@ int main(int argc, char** argv) {
 
   std::string families = "f-ls,2l-ls", depths = "0,2,4,6,8", subdivisions = "4,6,8";
   std::string angles = number_text(LsLookup{}.angle_degrees);  // the lookup's default angle
+  std::string behinds = ls_behind_name(LsLookup{}.behind);
+  std::string min_triangles = std::to_string(LsBuildOptions{}.min_triangles);
   int start_bounce = 1;
   bool no_plot = false;
-  auto* sweep_cmd = app.add_subcommand("sweep", "MRays/s against RMSE over D, N and the refusal angle; plots the trade-off");
+  auto* sweep_cmd = app.add_subcommand(
+      "sweep", "MRays/s against RMSE over D, N, the refusal angle, the behind mode and the smallest subtree; plots the trade-off");
   sweep_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
   sweep_cmd->add_option("--families", families, "f-ls, 2l-ls or both")->capture_default_str();
   sweep_cmd->add_option("--depths", depths, "integration depths D")->capture_default_str();
   sweep_cmd->add_option("--subdivisions", subdivisions, "subdivisions N")->capture_default_str();
   sweep_cmd->add_option("--angles", angles, "refusal angles in degrees (default: --ls-angle's)")->capture_default_str();
+  sweep_cmd->add_option("--behinds", behinds, "--ls-behind modes: exact, empty, reverse (default: --ls-behind's)")
+      ->capture_default_str();
+  sweep_cmd->add_option("--min-triangles", min_triangles,
+                        "smallest subtrees that get a Line Space, each value a build (default: --ls-min-triangles')")
+      ->capture_default_str();
   sweep_cmd->add_option("--start-bounce", start_bounce, "the Line Space traces bounces >= this one")->capture_default_str();
   sweep_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
   sweep_cmd->add_option("--out", out_dir, "folder for sweep.{csv,json,md} and tradeoff.{png,svg}")->default_val("out/sweep");
@@ -296,9 +304,18 @@ int main(int argc, char** argv) {
         throw InputError("sweep: --angles and --ls-angle both set the refusal angle; give one of them");
       const ImageSettings settings = image_settings();
       grid.angles = angles_given ? parse_angle_list(angles) : std::vector<float>{settings.lookup.angle_degrees};
+      const bool behinds_given = sweep_cmd->get_option("--behinds")->count() > 0;
+      if (behinds_given && sweep_cmd->get_option("--ls-behind")->count() > 0)
+        throw InputError("sweep: --behinds and --ls-behind both set the behind mode; give one of them");
+      grid.behinds = behinds_given ? parse_behind_list(behinds) : std::vector<LsBehind>{settings.lookup.behind};
+      const bool min_triangles_given = sweep_cmd->get_option("--min-triangles")->count() > 0;
+      if (min_triangles_given && sweep_cmd->get_option("--ls-min-triangles")->count() > 0)
+        throw InputError("sweep: --min-triangles and --ls-min-triangles both set the smallest subtree; give one of them");
       grid.start_bounce = start_bounce;
       const Scene scene = load_scene(scene_spec);
       const AccelOptions accel_options = ls_flags.options();
+      grid.min_triangles = min_triangles_given ? parse_min_triangles_list(min_triangles)
+                                               : std::vector<uint32_t>{accel_options.ls.min_triangles};
       auto renderer = make_study_renderer(device, scene, accel_options);
       const Sweep sweep = run_sweep(*renderer, scene_spec, grid, settings, log_line);
       write_sweep(out_dir, sweep);

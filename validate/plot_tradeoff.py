@@ -42,6 +42,10 @@ def main(folder):
             label = "D%d N%d" % (p["depth"], p["subdivision"])
             if len({q["angle"] for q in points}) > 1:
                 label += " %g°" % p["angle"]
+            if len({q.get("behind") for q in points}) > 1:
+                label += " " + p["behind"]
+            if len({q.get("min_triangles") for q in points}) > 1:
+                label += " M%d" % p["min_triangles"]
             ax.annotate(label, (p["error"], p["speedup_vs_bvh"]), fontsize=6, xytext=(4, 3),
                         textcoords="offset points")
     # The exact F-BVH (RMSE 0, speed-up 1) is always on the front: nothing is more accurate.
@@ -56,9 +60,12 @@ def main(folder):
                   % ("rmse_bias ± standard error" if biased else "RMSE", sweep["start_bounce"]))
     ax.set_ylabel("speed-up over F-BVH, bounces >= 1")
     spp = ("auto from %d" % sweep["spp"]) if sweep.get("spp_auto") else "%d" % sweep["spp"]
+    legend = sweep["device"]
+    if len({p.get("min_triangles") for p in points}) > 1:
+        legend += "; M: the smallest subtree with a Line Space (--ls-min-triangles)"
     ax.set_title("%s, %dx%d, %s spp, %d bounces — marker area ∝ memory (largest %.1f MB)\n%s"
                  % (sweep["scene"], sweep["width"], sweep["height"], spp, sweep["bounces"],
-                    biggest / 1e6, sweep["device"]), fontsize=8)
+                    biggest / 1e6, legend), fontsize=8)
     ax.legend(fontsize=8, markerscale=0.6)
     ax.grid(True, lw=0.3)
     fig.tight_layout()

@@ -42,6 +42,13 @@ void StudyRenderer::set_plan(const LsPlanOptions& plan) {
     it = it->second.spec.budgeted ? built_.erase(it) : std::next(it);
 }
 
+void StudyRenderer::set_ls_min_triangles(uint32_t min_triangles) {
+  if (options_.ls.min_triangles == min_triangles) return;
+  options_.ls.min_triangles = min_triangles;
+  for (auto it = built_.begin(); it != built_.end();)
+    it = it->second.spec.line_space() ? built_.erase(it) : std::next(it);
+}
+
 std::unique_ptr<StudyRenderer> make_cpu_study_renderer(const Scene& scene, const AccelOptions& options) {
   return std::make_unique<StudyRenderer>(make_cpu_backend(), scene, options);
 }

@@ -29,6 +29,8 @@ class StudyRenderer {
   void release(const StructureSpec& spec) { built_.erase(spec.name()); }
   // New 2l-ls:auto planner options (the budget study): a built 2l-ls:auto structure is dropped.
   void set_plan(const LsPlanOptions& plan);
+  // A new --ls-min-triangles: the built Line Space structures are dropped.
+  void set_ls_min_triangles(uint32_t min_triangles);
 
  private:
   std::unique_ptr<Backend> backend_;

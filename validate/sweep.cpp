@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 namespace ls {
@@ -56,6 +57,24 @@ std::vector<float> parse_angle_list(const std::string& text) {
   return out;
 }
 
+std::vector<LsBehind> parse_behind_list(const std::string& text) {
+  std::vector<LsBehind> out;
+  for (const std::string& item : split(text)) {
+    try {
+      out.push_back(parse_ls_behind(item));
+    } catch (const InputError&) {
+      throw InputError("--behinds " + text + ": '" + item + "' is not a mode (exact, empty or reverse)");
+    }
+  }
+  return out;
+}
+
+std::vector<uint32_t> parse_min_triangles_list(const std::string& text) {
+  std::vector<uint32_t> out;
+  for (int v : parse_int_list(text, "--min-triangles", 0, std::numeric_limits<int>::max())) out.push_back(uint32_t(v));
+  return out;
+}
+
 std::vector<StructureKind> parse_families(const std::string& text) {
   std::vector<StructureKind> out;
   for (const std::string& item : split(text)) {
@@ -87,12 +106,13 @@ void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s) 
 
 Table Sweep::table() const {
   Table t;
-  t.header = {"structure", "depth", "subdivision", "angle", "rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp",
+  t.header = {"structure", "depth", "subdivision", "angle", "behind", "min_triangles", "rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp",
               "spp_stop", "mrays_per_s", "speedup_vs_bvh", "bytes", "bytes_ls", "ls_nodes", "build_seconds", "pareto",
               "refused"};
   for (const SweepPoint& p : points) {
     const bool ok = p.refused.empty();
     t.rows.push_back({p.structure, std::to_string(p.depth), std::to_string(p.subdivision), fixed(p.angle, 1),
+                      ls_behind_name(p.behind), std::to_string(p.min_triangles),
                       ok ? fixed(p.rmse, 6) : "", ok ? fixed(p.bias.rmse_bias, 6) : "",
                       ok ? fixed(p.bias.rmse_bias_stderr, 6) : "", ok ? fixed(p.bias.noise_floor, 6) : "",
                       ok ? std::to_string(p.spp) : "", p.spp_stop,
@@ -108,7 +128,8 @@ nlohmann::json Sweep::json() const {
   nlohmann::json pts = nlohmann::json::array();
   for (const SweepPoint& p : points) {
     nlohmann::json j{{"structure", p.structure}, {"depth", p.depth}, {"subdivision", p.subdivision},
-                     {"angle", p.angle}, {"pareto", p.pareto}};
+                     {"angle", p.angle}, {"behind", ls_behind_name(p.behind)}, {"min_triangles", p.min_triangles},
+                     {"pareto", p.pareto}};
     if (p.refused.empty()) {
       j.update({{"rmse", p.rmse}, {"rmse_bias", number_or_null(p.bias.rmse_bias)},
                 {"rmse_bias_stderr", number_or_null(p.bias.rmse_bias_stderr)},
@@ -141,55 +162,62 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
   sweep.reference_bytes = reference.bytes;
   log("reference (bvh): " + fixed(sweep.reference_mrays_per_s, 2) + " MRays/s");
 
-  const size_t total = grid.angles.size() * grid.families.size() * grid.depths.size() * grid.subdivisions.size();
-  size_t done = 0;
-  for (float angle : grid.angles) {
-    ImageSettings at_angle = settings;  // the angle is the lookup's: the structures stay built
-    at_angle.lookup.angle_degrees = angle;
-    for (StructureKind family : grid.families)
-      for (int depth : grid.depths)
-        for (int n : grid.subdivisions) {
-          StructureSpec spec;
-          spec.kind = family;
-          spec.depth = depth;
-          spec.subdivision = n;
-          SweepPoint p;
-          p.structure = spec.name();
-          p.depth = depth;
-          p.subdivision = n;
-          p.angle = angle;
-          ++done;
-          try {
-            const Accel& accel = renderer.structure(spec);
-            p.bytes = accel.bytes_total();
-            p.bytes_ls = accel.bytes_ls();
-            p.ls_nodes = accel.ls_info.ls_nodes;
-            p.build_seconds = accel.build_seconds;
-          } catch (const InputError& e) {
-            p.refused = e.what();
-          }
-          if (p.refused.empty()) {
-            const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), at_angle, reference);
-            p.rmse = m.rmse;
-            p.bias = m.bias;
-            p.spp = m.spp;
-            p.spp_stop = m.spp_stop;
-            p.mrays_per_s = m.mrays_per_s;
-            p.speedup = sweep.reference_mrays_per_s > 0.0 ? m.mrays_per_s / sweep.reference_mrays_per_s : 0.0;
-            renderer.release(spec);
-          }
-          sweep.points.push_back(p);
-          std::string line = "[";
-          line += std::to_string(done) + "/" + std::to_string(total) + "] ";
-          line += p.structure + " angle " + fixed(angle, 1) + ": ";
-          if (p.refused.empty())
-            line += "RMSE " + rmse_text(p.rmse) + ", rmse_bias " + bias_text(p.bias) + " (" + std::to_string(p.spp) +
-                    " spp" + (p.spp_stop.empty() ? "" : ", " + p.spp_stop) + "), " + fixed(p.speedup, 2) + "x F-BVH, " +
-                    fixed(double(p.bytes) / 1e6, 1) + " MB";
-          else
-            line += "refused: " + p.refused;
-          log(line);
-        }
+  // Every point of the grid, in the order it is measured: the smallest subtree, a build option,
+  // outermost; the behind mode and the angle are the lookup's and need no build of their own.
+  std::vector<std::pair<StructureSpec, SweepPoint>> grid_points;
+  for (uint32_t min_triangles : grid.min_triangles)
+    for (LsBehind behind : grid.behinds)
+      for (float angle : grid.angles)
+        for (StructureKind family : grid.families)
+          for (int depth : grid.depths)
+            for (int n : grid.subdivisions) {
+              const StructureSpec spec{family, depth, n};
+              SweepPoint p;
+              p.structure = spec.name();
+              p.depth = depth;
+              p.subdivision = n;
+              p.angle = angle;
+              p.behind = behind;
+              p.min_triangles = min_triangles;
+              grid_points.emplace_back(spec, p);
+            }
+  for (auto& [spec, p] : grid_points) {
+    renderer.set_ls_min_triangles(p.min_triangles);
+    try {
+      const Accel& accel = renderer.structure(spec);
+      p.bytes = accel.bytes_total();
+      p.bytes_ls = accel.bytes_ls();
+      p.ls_nodes = accel.ls_info.ls_nodes;
+      p.build_seconds = accel.build_seconds;
+    } catch (const InputError& e) {
+      p.refused = e.what();
+    }
+    if (p.refused.empty()) {
+      ImageSettings lookup = settings;
+      lookup.lookup.angle_degrees = p.angle;
+      lookup.lookup.behind = p.behind;
+      const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), lookup, reference);
+      p.rmse = m.rmse;
+      p.bias = m.bias;
+      p.spp = m.spp;
+      p.spp_stop = m.spp_stop;
+      p.mrays_per_s = m.mrays_per_s;
+      p.speedup = sweep.reference_mrays_per_s > 0.0 ? m.mrays_per_s / sweep.reference_mrays_per_s : 0.0;
+      renderer.release(spec);
+    }
+    sweep.points.push_back(p);
+    std::string line = "[" + std::to_string(sweep.points.size()) + "/" + std::to_string(grid_points.size()) + "] ";
+    line += p.structure + " angle " + fixed(p.angle, 1);
+    if (grid.behinds.size() > 1) line += std::string(" ") + ls_behind_name(p.behind);
+    if (grid.min_triangles.size() > 1) line += " min-triangles " + std::to_string(p.min_triangles);
+    line += ": ";
+    if (p.refused.empty())
+      line += "RMSE " + rmse_text(p.rmse) + ", rmse_bias " + bias_text(p.bias) + " (" + std::to_string(p.spp) + " spp" +
+              (p.spp_stop.empty() ? "" : ", " + p.spp_stop) + "), " + fixed(p.speedup, 2) + "x F-BVH, " +
+              fixed(double(p.bytes) / 1e6, 1) + " MB";
+    else
+      line += "refused: " + p.refused;
+    log(line);
   }
   mark_pareto(sweep.points, sweep.reference_mrays_per_s);
   return sweep;

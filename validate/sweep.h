@@ -1,5 +1,6 @@
 // `linespace-validate sweep`: the speed/accuracy/memory trade-off of F-LS and 2L-LS over integration
-// depth D, subdivision N and the refusal angle on one scene.  Each configuration traces bounces >=
+// depth D, subdivision N, the refusal angle, the behind-the-origin mode and the smallest subtree that
+// gets a Line Space, on one scene.  Each configuration traces bounces >=
 // start with its Line Space (exact before), against the all-exact reference of the same run.  The
 // data is written first (CSV, JSON); the plot is a separate step (plot_tradeoff.py).
 #pragma once
@@ -20,6 +21,8 @@ struct SweepGrid {
   std::vector<int> depths = {0, 2, 4, 6, 8};
   std::vector<int> subdivisions = {4, 6, 8};
   std::vector<float> angles = {LsLookup{}.angle_degrees};
+  std::vector<LsBehind> behinds = {LsLookup{}.behind};
+  std::vector<uint32_t> min_triangles = {LsBuildOptions{}.min_triangles};  // --ls-min-triangles: each value a build
   int start_bounce = 1;
 };
 
@@ -27,6 +30,8 @@ struct SweepPoint {
   std::string structure;
   int depth = 0, subdivision = 0;
   float angle = 0.0f;
+  LsBehind behind = LsBehind::Exact;
+  uint32_t min_triangles = 0;
   double rmse = 0.0, mrays_per_s = 0.0, speedup = 0.0, build_seconds = 0.0;
   BiasEstimate bias;         // rmse_bias: the accuracy the Pareto front is drawn on
   int spp = 0;
@@ -50,6 +55,8 @@ struct Sweep {
 
 std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int lo, int hi);
 std::vector<float> parse_angle_list(const std::string& text);
+std::vector<LsBehind> parse_behind_list(const std::string& text);
+std::vector<uint32_t> parse_min_triangles_list(const std::string& text);
 std::vector<StructureKind> parse_families(const std::string& text);
 
 Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings, const Log& log);
