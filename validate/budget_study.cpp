@@ -27,14 +27,17 @@ BudgetSide measure_side(StudyRenderer& renderer, const StructureSpec& spec, cons
     side.bias.push_back(m.bias);
     side.spp.push_back(m.spp);
     side.spp_stop.push_back(m.spp_stop);
-    if (k == 1) side.mrays_per_s = m.mrays_per_s;
+    if (k == 1) {
+      side.mrays_per_s = m.mrays_per_s;
+      side.speedup = m.speedup;
+    }
     log("  " + side.structure + " from bounce " + std::to_string(k) + ": RMSE " + rmse_text(m.rmse) + ", rmse_bias " +
         bias_text(m.bias) + " (" + spp_text(m) + "), " + fixed(m.mrays_per_s, 2) + " MRays/s");
   }
   return side;
 }
 
-nlohmann::json side_json(const BudgetSide& s, double reference_mrays_per_s) {
+nlohmann::json side_json(const BudgetSide& s) {
   nlohmann::json bias = nlohmann::json::array(), stderr_ = nlohmann::json::array(), floor = nlohmann::json::array();
   for (const BiasEstimate& b : s.bias) {
     bias.push_back(number_or_null(b.rmse_bias));
@@ -49,7 +52,7 @@ nlohmann::json side_json(const BudgetSide& s, double reference_mrays_per_s) {
           {"spp_from_bounce", s.spp},
           {"spp_stop_from_bounce", s.spp_stop},
           {"mrays_per_s", s.mrays_per_s},
-          {"speedup_vs_bvh", reference_mrays_per_s > 0.0 ? s.mrays_per_s / reference_mrays_per_s : 0.0},
+          {"speedup_vs_bvh", s.speedup},
           {"bytes_ls", s.bytes_ls},
           {"build_seconds", s.build_seconds}};
 }
@@ -126,7 +129,7 @@ Table BudgetStudy::table() const {
     }
     auto line = [&](const BudgetSide& s, const std::string& predicted, const PilotFigures& pilot, const std::string& verdict) {
       std::vector<std::string> l{s.structure, mb(r.budget), mb(s.bytes_ls), predicted, fixed(s.mrays_per_s, 2),
-                                 fixed(reference_mrays_per_s > 0.0 ? s.mrays_per_s / reference_mrays_per_s : 0.0, 2)};
+                                 fixed(s.speedup, 2)};
       for (double e : s.rmse) l.push_back(rmse_text(e));
       for (const BiasEstimate& b : s.bias) l.push_back(bias_text(b));
       l.insert(l.end(), {fixed(pilot.error, 5), fixed(pilot.saved_work, 2), fixed(s.build_seconds, 2), verdict});
@@ -160,8 +163,8 @@ nlohmann::json BudgetStudy::json() const {
       j["refused"] = r.refused;
     } else {
       j["budget_bytes"] = r.budget;
-      j["uniform"] = side_json(r.uniform, reference_mrays_per_s);
-      j["auto"] = side_json(r.planned, reference_mrays_per_s);
+      j["uniform"] = side_json(r.uniform);
+      j["auto"] = side_json(r.planned);
       j["auto"]["predicted_bytes"] = r.plan.predicted_bytes;
       j["auto"]["plan"] = ls_plan_json(r.plan);
       j["lower_rmse_at_every_start_bounce"] = r.lower_rmse();  // on rmse_bias

@@ -42,6 +42,7 @@ struct ImageFlags {
   std::string size = "256x256", spp = "4";
   int bounces = 3;
   uint32_t seed = 1;
+  int timing_rounds = ImageSettings{}.timing_rounds;
   // Empty: not given (one ImageFlags serves every subcommand, so the flags' own counts cannot tell).
   std::string auto_rel_stderr, auto_seconds;
 
@@ -58,6 +59,10 @@ struct ImageFlags {
                     "(default " + number_text(SppAuto{}.seconds) + ")");
     app->add_option("--bounces", bounces, "indirect bounces after the primary hit")->capture_default_str()->check(CLI::Range(1, 64));
     app->add_option("--seed", seed)->capture_default_str();
+    app->add_option("--timing-rounds", timing_rounds,
+                    "renders of each configuration and of the exact F-BVH right after it; the speed-up is the median "
+                    "ratio")
+        ->capture_default_str()->check(CLI::Range(1, 100));
   }
   static constexpr int kAutoStartSpp = 4;
   // The whole text as a number, else NaN (which every range check refuses).
@@ -78,6 +83,7 @@ struct ImageFlags {
     i.height = s.height;
     i.bounces = bounces;
     i.seed = seed;
+    i.timing_rounds = timing_rounds;
     if (spp == "auto") {
       const double rel = auto_rel_stderr.empty() ? SppAuto{}.rel_stderr : number(auto_rel_stderr);
       const double seconds = auto_seconds.empty() ? SppAuto{}.seconds : number(auto_seconds);

@@ -53,12 +53,41 @@ Reference render_reference(StudyRenderer& renderer, const ImageSettings& setting
   const Schedule exact = parse_schedule("bvh");
   Reference r;
   r.options = settings.options(exact);
+  r.timing_rounds = settings.timing_rounds;
   r.levels.push_back(render_split(renderer, r.options));
   r.result = r.levels.front().combined;
   r.scale = exposure_scale(r.result.total);
   r.bytes = schedule_bytes(renderer, exact, settings.bounces);
   return r;
 }
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// m's speed: round 1 times m's own render (both halves) and then the exact F-BVH's; each further
+// round renders both again, one right after the other, at m's spp.
+void time_beside_exact(StudyRenderer& renderer, const RenderOptions& options, Reference& reference, Measured& m) {
+  RenderOptions config = options;
+  config.spp = m.spp;
+  RenderOptions exact = reference.options;
+  exact.spp = m.spp;
+  std::vector<double> own{m.result.indirect_mrays_per_s()}, exact_speed, ratio;
+  for (int round = 0; round < std::max(1, reference.timing_rounds); ++round) {
+    if (round > 0) own.push_back(renderer.render(config).indirect_mrays_per_s());
+    exact_speed.push_back(renderer.render(exact).indirect_mrays_per_s());
+    ratio.push_back(exact_speed.back() > 0.0 ? own.back() / exact_speed.back() : 0.0);
+  }
+  m.mrays_per_s = median(own);
+  m.exact_mrays_per_s = median(exact_speed);
+  m.speedup = median(ratio);
+}
+
+}  // namespace
 
 Measured measure(StudyRenderer& renderer, const Schedule& schedule, const ImageSettings& settings, Reference& reference) {
   return measure(renderer, settings.options(schedule), reference, settings.auto_spp);
@@ -95,7 +124,7 @@ Measured measure(StudyRenderer& renderer, const RenderOptions& options, Referenc
   m.rmse = rmse(ref->combined.total, m.result.total, reference.scale);
   for (size_t k = 0; k < m.result.bounce_images.size(); ++k)
     m.contribution_rmse.push_back(rmse(ref->combined.bounce_images[k], m.result.bounce_images[k], reference.scale));
-  m.mrays_per_s = m.result.indirect_mrays_per_s();
+  time_beside_exact(renderer, options, reference, m);
   for (const StructureSpec& spec : render_structures(options)) m.bytes += renderer.structure(spec).bytes_total();
   return m;
 }

@@ -37,6 +37,10 @@ struct ImageSettings {
   uint32_t seed = 1;
   LsLookup lookup;  // --ls-angle, --ls-behind: every render's Line Space lookups
   SppAuto auto_spp;
+  // --timing-rounds: rounds of a configuration's render and the exact F-BVH's, one right after the
+  // other, whose median ratio is its speed-up (Measured).  3: on a shared 2-core host single renders
+  // of a 128x128, 8 spp sweep moved 2.4x between configurations, more than any Line Space's effect.
+  int timing_rounds = 3;
   RenderOptions options(const Schedule& schedule) const;
 };
 
@@ -45,6 +49,7 @@ struct Reference {
   float scale = 1.0f;   // e of docs/design.md §7, from its total image (with --spp auto: at the starting spp)
   size_t bytes = 0;
   RenderOptions options;           // what renders it
+  int timing_rounds = 1;           // the settings' (ImageSettings::timing_rounds)
   std::deque<SplitRender> levels;  // at spp, 2 spp, 4 spp, ... (more than one only with --spp auto)
   // The reference over samples 0 .. total - 1 (total: spp times a power of 2), rendered when first asked.
   const SplitRender& at(StudyRenderer& renderer, int total);
@@ -57,7 +62,14 @@ struct Measured {
   BiasEstimate bias;                      // total image: rmse_bias, its standard error, the noise floor
   int spp = 0;                            // samples per pixel the figures rest on
   std::string spp_stop;                   // --spp auto: "converged", "time budget" or "max spp"; else empty
-  double mrays_per_s = 0.0;               // rays of bounces >= 1 per second of tracing
+  // Speed: rays of bounces >= 1 per second of tracing, the medians over the timing rounds of this
+  // configuration's render and of the exact F-BVH's on the same options and spp, rendered right
+  // after it; the speed-up is the median of the rounds' ratios.  (The reference's own timing, once at
+  // the start of a study, carried its warm-up and the machine's drift into every ratio: a fireplace
+  // sweep at 8 spp put Line Spaces with no error at 1.45x the F-BVH.)
+  double mrays_per_s = 0.0;
+  double exact_mrays_per_s = 0.0;
+  double speedup = 0.0;
   size_t bytes = 0;                       // distinct structures of the schedule
   RenderResult result;                    // both halves combined
   std::vector<glm::vec3> reference_total; // the reference's total image at the same spp (heat-maps)

@@ -27,6 +27,7 @@ struct PaperOptions {
 struct ScheduleMeasure {
   std::string paper_name, schedule;
   double rmse = 0.0, mrays_per_s = 0.0;
+  double speedup = 0.0;  // over the exact F-BVH timed beside it (Measured)
   BiasEstimate bias;
   int spp = 0;
   std::string spp_stop;

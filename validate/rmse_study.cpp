@@ -48,7 +48,7 @@ Table RmseStudy::summary() const {
       while (line.size() < t.header.size()) line.push_back("-");
     } else {
       line.push_back(fixed(r.mrays_per_s, 2));
-      line.push_back(fixed(r.mrays_per_s / reference_mrays_per_s, 2));
+      line.push_back(fixed(r.speedup, 2));
       line.push_back(fixed(double(r.bytes) / 1e6, 1));
       for (int k = 1; k <= settings.bounces; ++k) {
         const RmseRow* at = find(r.structure, k);
@@ -119,7 +119,7 @@ nlohmann::json RmseStudy::json() const {
       j["spp"] = r.spp;
       if (!r.spp_stop.empty()) j["spp_stop"] = r.spp_stop;
       j["mrays_per_s"] = r.mrays_per_s;
-      j["speedup_vs_bvh"] = reference_mrays_per_s > 0.0 ? r.mrays_per_s / reference_mrays_per_s : 0.0;
+      j["speedup_vs_bvh"] = r.speedup;
       j["bytes"] = r.bytes;
       j["bytes_ls"] = r.bytes_ls;
       j["ls_nodes"] = r.ls_nodes;
@@ -185,11 +185,14 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
       row.spp = m.spp;
       row.spp_stop = m.spp_stop;
       row.mrays_per_s = m.mrays_per_s;
+      row.speedup = m.speedup;
       study.rows.push_back(row);
-      log("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + row.structure + " from bounce " +
-          std::to_string(k) + ": RMSE " + rmse_text(row.rmse) + ", rmse_bias " + bias_text(row.bias) + ", noise floor " +
-          rmse_text(row.bias.noise_floor) + " (" + spp_text(m) + "), " + fixed(row.mrays_per_s, 2) + " MRays/s, " +
-          fixed(seconds_since(t0), 2) + " s");
+      std::string line = "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + row.structure +
+                         " from bounce " + std::to_string(k) + ": RMSE " + rmse_text(row.rmse) + ", rmse_bias " +
+                         bias_text(row.bias) + ", noise floor " + rmse_text(row.bias.noise_floor);
+      line += " (" + spp_text(m) + "), " + fixed(row.mrays_per_s, 2) + " MRays/s, ";
+      line += fixed(row.speedup, 2) + "x F-BVH beside it, " + fixed(seconds_since(t0), 2) + " s";
+      log(line);
       // The heat-map shows the difference of the images averaged over both halves (all samples).
       if (!out_dir.empty())
         write_error_images(out_dir + "/" + file_safe(row.structure) + "_from_bounce_" + std::to_string(k),

@@ -24,6 +24,7 @@ struct RmseRow {
   int spp = 0;
   std::string spp_stop;                   // --spp auto: why it stopped adding samples
   double mrays_per_s = 0.0;
+  double speedup = 0.0;                   // over the exact F-BVH timed beside this row (Measured)
   size_t bytes = 0;                       // the structure's own
   size_t ls_nodes = 0, bytes_ls = 0;
   double build_seconds = 0.0;

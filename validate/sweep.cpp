@@ -91,14 +91,13 @@ double error_of(const SweepPoint& p) { return p.bias.valid() ? p.bias.rmse_bias 
 
 }  // namespace
 
-void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s) {
+void mark_pareto(std::vector<SweepPoint>& points) {
   for (SweepPoint& p : points) {
-    p.pareto = p.refused.empty() &&
-               !(reference_mrays_per_s >= p.mrays_per_s && (reference_mrays_per_s > p.mrays_per_s || error_of(p) > 0.0));
+    p.pareto = p.refused.empty() && !(1.0 >= p.speedup && (1.0 > p.speedup || error_of(p) > 0.0));
     for (const SweepPoint& q : points) {
       if (&q == &p || !q.refused.empty() || !p.pareto) continue;
-      const bool as_good = q.mrays_per_s >= p.mrays_per_s && error_of(q) <= error_of(p);
-      const bool better = q.mrays_per_s > p.mrays_per_s || error_of(q) < error_of(p);
+      const bool as_good = q.speedup >= p.speedup && error_of(q) <= error_of(p);
+      const bool better = q.speedup > p.speedup || error_of(q) < error_of(p);
       if (as_good && better) p.pareto = false;
     }
   }
@@ -107,7 +106,7 @@ void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s) 
 Table Sweep::table() const {
   Table t;
   t.header = {"structure", "depth", "subdivision", "angle", "behind", "min_triangles", "rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp",
-              "spp_stop", "mrays_per_s", "speedup_vs_bvh", "bytes", "bytes_ls", "ls_nodes", "build_seconds", "pareto",
+              "spp_stop", "mrays_per_s", "exact_mrays_per_s", "speedup_vs_bvh", "bytes", "bytes_ls", "ls_nodes", "build_seconds", "pareto",
               "refused"};
   for (const SweepPoint& p : points) {
     const bool ok = p.refused.empty();
@@ -116,7 +115,8 @@ Table Sweep::table() const {
                       ok ? fixed(p.rmse, 6) : "", ok ? fixed(p.bias.rmse_bias, 6) : "",
                       ok ? fixed(p.bias.rmse_bias_stderr, 6) : "", ok ? fixed(p.bias.noise_floor, 6) : "",
                       ok ? std::to_string(p.spp) : "", p.spp_stop,
-                      ok ? fixed(p.mrays_per_s, 4) : "", ok ? fixed(p.speedup, 4) : "",
+                      ok ? fixed(p.mrays_per_s, 4) : "", ok ? fixed(p.exact_mrays_per_s, 4) : "",
+                      ok ? fixed(p.speedup, 4) : "",
                       ok ? std::to_string(p.bytes) : "", ok ? std::to_string(p.bytes_ls) : "",
                       ok ? std::to_string(p.ls_nodes) : "", ok ? fixed(p.build_seconds, 3) : "",
                       p.pareto ? "1" : "0", p.refused});
@@ -133,7 +133,8 @@ nlohmann::json Sweep::json() const {
     if (p.refused.empty()) {
       j.update({{"rmse", p.rmse}, {"rmse_bias", number_or_null(p.bias.rmse_bias)},
                 {"rmse_bias_stderr", number_or_null(p.bias.rmse_bias_stderr)},
-                {"noise_floor", number_or_null(p.bias.noise_floor)}, {"spp", p.spp}, {"mrays_per_s", p.mrays_per_s}, {"speedup_vs_bvh", p.speedup}, {"bytes", p.bytes},
+                {"noise_floor", number_or_null(p.bias.noise_floor)}, {"spp", p.spp}, {"mrays_per_s", p.mrays_per_s},
+                {"exact_mrays_per_s", p.exact_mrays_per_s}, {"speedup_vs_bvh", p.speedup}, {"bytes", p.bytes},
                 {"bytes_ls", p.bytes_ls}, {"ls_nodes", p.ls_nodes}, {"build_seconds", p.build_seconds}});
     } else {
       j["refused"] = p.refused;
@@ -202,7 +203,8 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
       p.spp = m.spp;
       p.spp_stop = m.spp_stop;
       p.mrays_per_s = m.mrays_per_s;
-      p.speedup = sweep.reference_mrays_per_s > 0.0 ? m.mrays_per_s / sweep.reference_mrays_per_s : 0.0;
+      p.exact_mrays_per_s = m.exact_mrays_per_s;
+      p.speedup = m.speedup;
       renderer.release(spec);
     }
     sweep.points.push_back(p);
@@ -219,7 +221,7 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
       line += "refused: " + p.refused;
     log(line);
   }
-  mark_pareto(sweep.points, sweep.reference_mrays_per_s);
+  mark_pareto(sweep.points);
   return sweep;
 }
 

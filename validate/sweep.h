@@ -32,7 +32,9 @@ struct SweepPoint {
   float angle = 0.0f;
   LsBehind behind = LsBehind::Exact;
   uint32_t min_triangles = 0;
-  double rmse = 0.0, mrays_per_s = 0.0, speedup = 0.0, build_seconds = 0.0;
+  double rmse = 0.0, mrays_per_s = 0.0, build_seconds = 0.0;
+  double exact_mrays_per_s = 0.0;  // the exact F-BVH timed beside this point (Measured)
+  double speedup = 0.0;            // mrays_per_s / exact_mrays_per_s
   BiasEstimate bias;         // rmse_bias: the accuracy the Pareto front is drawn on
   int spp = 0;
   std::string spp_stop;      // --spp auto: why it stopped adding samples
@@ -61,9 +63,9 @@ std::vector<StructureKind> parse_families(const std::string& text);
 
 Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGrid& grid, const ImageSettings& settings, const Log& log);
 // On rmse_bias (sampling noise would move the front with spp; a point without an estimate, 1 spp,
-// falls back to its RMSE).  The exact reference (error 0 at reference_mrays_per_s) takes part: a point
-// it dominates is off the front.
-void mark_pareto(std::vector<SweepPoint>& points, double reference_mrays_per_s);
+// falls back to its RMSE) and the speed-up over the exact F-BVH timed beside each point (Measured).
+// The exact F-BVH (error 0, speed-up 1) takes part: a point it dominates is off the front.
+void mark_pareto(std::vector<SweepPoint>& points);
 
 // sweep.csv, sweep.json, sweep.md into dir.
 void write_sweep(const std::string& dir, const Sweep& sweep);
