@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 36> cases = {
+  const std::array<std::string, 37> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -40,6 +40,7 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "sweep --min-triangles 8 --ls-min-triangles 0",
       "sweep --min-triangles 8,x",
       "rmse --timing-rounds 0",
+      "policy --timing-rounds 3",  // policy times round-robin, by --repeat
       "paper --tables 5",
       "paper --subdivisions 7",
       "policy --thresholds 0",

@@ -342,6 +342,9 @@ int main(int argc, char** argv) {
                   settings.width, settings.height, image_flags.spp.c_str(), settings.bounces, study.device.c_str(),
                   study.table().markdown().c_str(), study.choices().markdown().c_str(), out_dir.c_str());
     } else if (*policy_cmd) {
+      if (policy_cmd->get_option("--timing-rounds")->count() > 0)
+        throw InputError("policy: --timing-rounds does not apply; policy times every configuration and the reference "
+                         "round-robin, --repeat times");
       const StructureSpec spec = parse_structure(policy_structure);
       const ImageSettings settings = image_settings();
       std::vector<int> starts;

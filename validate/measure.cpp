@@ -72,12 +72,16 @@ double median(std::vector<double> v) {
 // m's speed: round 1 times m's own render (both halves) and then the exact F-BVH's; each further
 // round renders both again, one right after the other, at m's spp.
 void time_beside_exact(StudyRenderer& renderer, const RenderOptions& options, Reference& reference, Measured& m) {
+  if (reference.timing_rounds == 0) {  // the study times its configurations itself
+    m.mrays_per_s = m.result.indirect_mrays_per_s();
+    return;
+  }
   RenderOptions config = options;
   config.spp = m.spp;
   RenderOptions exact = reference.options;
   exact.spp = m.spp;
   std::vector<double> own{m.result.indirect_mrays_per_s()}, exact_speed, ratio;
-  for (int round = 0; round < std::max(1, reference.timing_rounds); ++round) {
+  for (int round = 0; round < reference.timing_rounds; ++round) {
     if (round > 0) own.push_back(renderer.render(config).indirect_mrays_per_s());
     exact_speed.push_back(renderer.render(exact).indirect_mrays_per_s());
     ratio.push_back(exact_speed.back() > 0.0 ? own.back() / exact_speed.back() : 0.0);

@@ -49,7 +49,9 @@ struct Reference {
   float scale = 1.0f;   // e of docs/design.md §7, from its total image (with --spp auto: at the starting spp)
   size_t bytes = 0;
   RenderOptions options;           // what renders it
-  int timing_rounds = 1;           // the settings' (ImageSettings::timing_rounds)
+  // The settings' (ImageSettings::timing_rounds); 0: no timing beside the exact F-BVH, the study
+  // times its configurations itself (policy's round-robin --repeat).
+  int timing_rounds = 1;
   std::deque<SplitRender> levels;  // at spp, 2 spp, 4 spp, ... (more than one only with --spp auto)
   // The reference over samples 0 .. total - 1 (total: spp times a power of 2), rendered when first asked.
   const SplitRender& at(StudyRenderer& renderer, int total);

@@ -197,6 +197,7 @@ PolicyStudy run_policy_study(StudyRenderer& renderer, const std::string& scene, 
   study.repeats = repeats;
   study.structure_bytes = renderer.structure(structure).bytes_total();  // refused here if over the budget
   Reference reference = render_reference(renderer, settings);
+  reference.timing_rounds = 0;  // timed below: every configuration and the reference, round-robin
   study.reference_mrays_per_s = reference.result.indirect_mrays_per_s();
   study.reference_bytes = reference.bytes;
   log("reference (bvh): " + fixed(study.reference_mrays_per_s, 2) + " MRays/s");
