@@ -1,5 +1,6 @@
 #include "validate/measure.h"
 
+#include "common/base/median.h"
 #include "common/render/image_metrics.h"
 #include "common/render/render_types.h"
 #include "validate/table.h"
@@ -62,12 +63,6 @@ Reference render_reference(StudyRenderer& renderer, const ImageSettings& setting
 }
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // m's speed: round 1 times m's own render (both halves) and then the exact F-BVH's; each further
 // round renders both again, one right after the other, at m's spp.

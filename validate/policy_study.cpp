@@ -1,5 +1,6 @@
 #include "validate/policy_study.h"
 
+#include "common/base/median.h"
 #include "common/render/render_types.h"
 
 #include <algorithm>
@@ -241,10 +242,6 @@ PolicyStudy run_policy_study(StudyRenderer& renderer, const std::string& scene, 
     for (size_t i = 0; i < configs.size(); ++i) speeds[i].push_back(renderer.render(configs[i].second).indirect_mrays_per_s());
     log("timing round " + std::to_string(r + 1) + "/" + std::to_string(repeats) + " done");
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  };
   study.reference_mrays_per_s = median(speeds.back());
   for (size_t i = 0; i < configs.size(); ++i) {
     configs[i].first.mrays_per_s = median(speeds[i]);

@@ -1,6 +1,7 @@
 #include "cpu/app/render_frames.h"
 
 #include "common/base/interrupt.h"
+#include "common/base/median.h"
 #include "common/base/memory_budget.h"
 #include "common/base/system_info.h"
 #include "common/base/thread_limit.h"
@@ -51,12 +52,6 @@ std::string frame_name(int f) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "frame_%04d", f);
   return buf;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 double mean(const std::vector<double>& v) {
