@@ -33,8 +33,8 @@ struct SweepPoint {
   LsBehind behind = LsBehind::Exact;
   uint32_t min_triangles = 0;
   double rmse = 0.0, mrays_per_s = 0.0, build_seconds = 0.0;
-  double exact_mrays_per_s = 0.0;  // the exact F-BVH timed beside this point (Measured)
-  double speedup = 0.0;            // mrays_per_s / exact_mrays_per_s
+  double exact_mrays_per_s = 0.0;  // the exact F-BVH rendered beside this point: its median (Measured)
+  double speedup = 0.0;            // the median of the timing rounds' ratios (Measured)
   BiasEstimate bias;         // rmse_bias: the accuracy the Pareto front is drawn on
   int spp = 0;
   std::string spp_stop;      // --spp auto: why it stopped adding samples
