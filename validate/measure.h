@@ -57,13 +57,13 @@ struct Reference {
   const SplitRender& at(StudyRenderer& renderer, int total);
 };
 
-struct Measured {
-  std::string schedule;
-  double rmse = 0.0;                      // total image, all samples
-  std::vector<double> contribution_rmse;  // bounce 0..B images
-  BiasEstimate bias;                      // total image: rmse_bias, its standard error, the noise floor
-  int spp = 0;                            // samples per pixel the figures rest on
-  std::string spp_stop;                   // --spp auto: "converged", "time budget" or "max spp"; else empty
+// What a study row keeps of one measurement: its figures without its images.  The row types of
+// rmse, sweep and paper derive from it, so that a row takes them in one assignment.
+struct MeasuredFigures {
+  double rmse = 0.0;        // total image, all samples
+  BiasEstimate bias;        // total image: rmse_bias, its standard error, the noise floor
+  int spp = 0;              // samples per pixel the figures rest on
+  std::string spp_stop;     // --spp auto: "converged", "time budget" or "max spp"; else empty
   // Speed: rays of bounces >= 1 per second of tracing, the medians over the timing rounds of this
   // configuration's render and of the exact F-BVH's on the same options and spp, rendered right
   // after it; the speed-up is the median of the rounds' ratios.  (The reference's own timing, once at
@@ -72,6 +72,11 @@ struct Measured {
   double mrays_per_s = 0.0;
   double exact_mrays_per_s = 0.0;
   double speedup = 0.0;
+};
+
+struct Measured : MeasuredFigures {
+  std::string schedule;
+  std::vector<double> contribution_rmse;  // bounce 0..B images
   size_t bytes = 0;                       // distinct structures of the schedule
   RenderResult result;                    // both halves combined
   std::vector<glm::vec3> reference_total; // the reference's total image at the same spp (heat-maps)

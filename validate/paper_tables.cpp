@@ -366,7 +366,8 @@ static void compose(const PaperOptions& options, const std::vector<const paper::
       t4.push_back({{"paper", m.paper_name}, {"schedule", m.schedule}, {"rmse", m.rmse},
                     {"rmse_bias", number_or_null(m.bias.rmse_bias)}, {"rmse_bias_stderr", number_or_null(m.bias.rmse_bias_stderr)},
                     {"noise_floor", number_or_null(m.bias.noise_floor)}, {"spp", m.spp}, {"spp_stop", m.spp_stop},
-                    {"mrays_per_s", m.mrays_per_s}, {"speedup_vs_bvh", m.speedup}, {"bytes", m.bytes},
+                    {"mrays_per_s", m.mrays_per_s}, {"exact_mrays_per_s", m.exact_mrays_per_s}, {"speedup_vs_bvh", m.speedup},
+                    {"bytes", m.bytes},
                     {"refused", m.refused}});
     scenes.push_back({{"scene", s.scene}, {"triangles", s.triangles}, {"objects", s.objects}, {"instances", s.instances},
                       {"paper_scene", paper::kScenes[size_t(s.paper_scene)]}, {"study", s.study.json()}, {"table4", t4}});
@@ -420,11 +421,7 @@ PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_opt
         RmseRow row;
         row.structure = spec.name();
         try {
-          const Accel& a = renderer->structure(spec);
-          row.bytes = a.bytes_total();
-          row.bytes_ls = a.bytes_ls();
-          row.ls_nodes = a.ls_info.ls_nodes;
-          row.build_seconds = a.build_seconds;
+          static_cast<BuiltFigures&>(row) = built_figures(renderer->structure(spec));
         } catch (const InputError& e) {
           row.refused = e.what();
         }
@@ -441,12 +438,7 @@ PaperReport run_paper(const PaperOptions& options, const AccelOptions& accel_opt
         sm.schedule = s.schedule;
         try {
           const Measured m = measure(*renderer, parse_schedule(s.schedule), settings, reference);
-          sm.rmse = m.rmse;
-          sm.bias = m.bias;
-          sm.spp = m.spp;
-          sm.spp_stop = m.spp_stop;
-          sm.mrays_per_s = m.mrays_per_s;
-          sm.speedup = m.speedup;
+          static_cast<MeasuredFigures&>(sm) = m;
           sm.bytes = m.bytes;
         } catch (const InputError& e) {
           sm.refused = e.what();

@@ -24,14 +24,10 @@ struct PaperOptions {
   float heatmap_max = 0.1f;
 };
 
-struct ScheduleMeasure {
+// The figures of MeasuredFigures (the speed-up over the exact F-BVH timed beside it).
+struct ScheduleMeasure : MeasuredFigures {
   std::string paper_name, schedule;
-  double rmse = 0.0, mrays_per_s = 0.0;
-  double speedup = 0.0;  // over the exact F-BVH timed beside it (Measured)
-  BiasEstimate bias;
-  int spp = 0;
-  std::string spp_stop;
-  size_t bytes = 0;
+  size_t bytes = 0;  // the schedule's distinct structures (Measured::bytes)
   std::string refused;
 };
 

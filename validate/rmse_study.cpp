@@ -119,6 +119,7 @@ nlohmann::json RmseStudy::json() const {
       j["spp"] = r.spp;
       if (!r.spp_stop.empty()) j["spp_stop"] = r.spp_stop;
       j["mrays_per_s"] = r.mrays_per_s;
+      j["exact_mrays_per_s"] = r.exact_mrays_per_s;
       j["speedup_vs_bvh"] = r.speedup;
       j["bytes"] = r.bytes;
       j["bytes_ls"] = r.bytes_ls;
@@ -158,11 +159,7 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
     std::string refused;
     RmseRow built;
     try {
-      const Accel& accel = renderer.structure(spec);
-      built.bytes = accel.bytes_total();
-      built.bytes_ls = accel.bytes_ls();
-      built.ls_nodes = accel.ls_info.ls_nodes;
-      built.build_seconds = accel.build_seconds;
+      static_cast<BuiltFigures&>(built) = built_figures(renderer.structure(spec));
     } catch (const InputError& e) {
       refused = e.what();
       log(spec.name() + ": refused: " + refused);
@@ -179,13 +176,8 @@ RmseStudy run_rmse_study(StudyRenderer& renderer, const std::string& scene, cons
       }
       t0 = std::chrono::steady_clock::now();
       const Measured m = measure(renderer, schedule_from(spec, k), settings, reference);
-      row.rmse = m.rmse;
+      static_cast<MeasuredFigures&>(row) = m;
       row.contribution_rmse = m.contribution_rmse;
-      row.bias = m.bias;
-      row.spp = m.spp;
-      row.spp_stop = m.spp_stop;
-      row.mrays_per_s = m.mrays_per_s;
-      row.speedup = m.speedup;
       study.rows.push_back(row);
       std::string line = "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + row.structure +
                          " from bounce " + std::to_string(k) + ": RMSE " + rmse_text(row.rmse) + ", rmse_bias " +

@@ -15,19 +15,12 @@
 
 namespace ls {
 
-struct RmseRow {
+// The figures of MeasuredFigures and of the structure as built (BuiltFigures::bytes: the
+// structure's own); the speed-up is over the exact F-BVH timed beside this row.
+struct RmseRow : MeasuredFigures, BuiltFigures {
   std::string structure;
   int start_bounce = 1;
-  double rmse = 0.0;
   std::vector<double> contribution_rmse;  // per bounce 0..B
-  BiasEstimate bias;                      // rmse_bias, rmse_bias_stderr, noise_floor
-  int spp = 0;
-  std::string spp_stop;                   // --spp auto: why it stopped adding samples
-  double mrays_per_s = 0.0;
-  double speedup = 0.0;                   // over the exact F-BVH timed beside this row (Measured)
-  size_t bytes = 0;                       // the structure's own
-  size_t ls_nodes = 0, bytes_ls = 0;
-  double build_seconds = 0.0;
   std::string refused;                    // non-empty: not built (the reason), no figures
 };
 

@@ -13,6 +13,10 @@
 
 namespace ls {
 
+BuiltFigures built_figures(const Accel& accel) {
+  return {accel.bytes_total(), accel.bytes_ls(), accel.ls_info.ls_nodes, accel.build_seconds};
+}
+
 StudyRenderer::StudyRenderer(std::unique_ptr<Backend> backend, const Scene& scene, const AccelOptions& options)
     : backend_(std::move(backend)), scene_(scene), options_(options) {}
 

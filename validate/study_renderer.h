@@ -16,6 +16,15 @@
 
 namespace ls {
 
+// What a built structure costs, as the study rows of rmse, sweep and paper report it.
+struct BuiltFigures {
+  size_t bytes = 0;     // the structure's own (Accel::bytes_total)
+  size_t bytes_ls = 0;  // of it, its Line Space
+  size_t ls_nodes = 0;
+  double build_seconds = 0.0;
+};
+BuiltFigures built_figures(const Accel& accel);
+
 class StudyRenderer {
  public:
   StudyRenderer(std::unique_ptr<Backend> backend, const Scene& scene, const AccelOptions& options);

@@ -185,11 +185,7 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
   for (auto& [spec, p] : grid_points) {
     renderer.set_ls_min_triangles(p.min_triangles);
     try {
-      const Accel& accel = renderer.structure(spec);
-      p.bytes = accel.bytes_total();
-      p.bytes_ls = accel.bytes_ls();
-      p.ls_nodes = accel.ls_info.ls_nodes;
-      p.build_seconds = accel.build_seconds;
+      static_cast<BuiltFigures&>(p) = built_figures(renderer.structure(spec));
     } catch (const InputError& e) {
       p.refused = e.what();
     }
@@ -197,14 +193,7 @@ Sweep run_sweep(StudyRenderer& renderer, const std::string& scene, const SweepGr
       ImageSettings lookup = settings;
       lookup.lookup.angle_degrees = p.angle;
       lookup.lookup.behind = p.behind;
-      const Measured m = measure(renderer, schedule_from(spec, grid.start_bounce), lookup, reference);
-      p.rmse = m.rmse;
-      p.bias = m.bias;
-      p.spp = m.spp;
-      p.spp_stop = m.spp_stop;
-      p.mrays_per_s = m.mrays_per_s;
-      p.exact_mrays_per_s = m.exact_mrays_per_s;
-      p.speedup = m.speedup;
+      static_cast<MeasuredFigures&>(p) = measure(renderer, schedule_from(spec, grid.start_bounce), lookup, reference);
       renderer.release(spec);
     }
     sweep.points.push_back(p);

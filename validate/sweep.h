@@ -26,19 +26,14 @@ struct SweepGrid {
   int start_bounce = 1;
 };
 
-struct SweepPoint {
+// The figures of MeasuredFigures (exact_mrays_per_s: the exact F-BVH rendered beside this point, the
+// speed-up the median of the timing rounds' ratios) and of the structure as built.
+struct SweepPoint : MeasuredFigures, BuiltFigures {
   std::string structure;
   int depth = 0, subdivision = 0;
   float angle = 0.0f;
   LsBehind behind = LsBehind::Exact;
   uint32_t min_triangles = 0;
-  double rmse = 0.0, mrays_per_s = 0.0, build_seconds = 0.0;
-  double exact_mrays_per_s = 0.0;  // the exact F-BVH rendered beside this point: its median (Measured)
-  double speedup = 0.0;            // the median of the timing rounds' ratios (Measured)
-  BiasEstimate bias;         // rmse_bias: the accuracy the Pareto front is drawn on
-  int spp = 0;
-  std::string spp_stop;      // --spp auto: why it stopped adding samples
-  size_t bytes = 0, bytes_ls = 0, ls_nodes = 0;
   bool pareto = false;       // no other point (nor the exact F-BVH) is at least as fast and as accurate (rmse_bias), and better in one
   std::string refused;       // non-empty: not built (the reason)
 };
