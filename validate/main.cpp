@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
   ls_flags.add_to(budget_cmd);
   threads_flag.add_to(budget_cmd);
   std::string policy_structure = "f-ls:8:6", thresholds = "0.05,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.99", start_bounces;
-  int policy_repeats = 1;
+  int policy_repeats = 3;  // as --timing-rounds: single renders on a shared host move by more than a Line Space's effect
   auto* policy_cmd = app.add_subcommand("policy", "bounce policy against throughput policy (render --throughput-switch) at equal speed");
   policy_cmd->add_option("--scene", scene_spec, "scene file or builtin:NAME")->capture_default_str();
   policy_cmd->add_option("--structure", policy_structure, "the approximate structure X both policies switch to")->capture_default_str();

@@ -54,7 +54,7 @@ struct PolicyComparison {
 struct PolicyStudy {
   std::string scene, device, structure;
   ImageSettings settings;
-  int repeats = 1;                  // timed renders per configuration (median MRays/s)
+  int repeats = 3;                  // timed renders per configuration (median MRays/s)
   double reference_mrays_per_s = 0.0;
   size_t reference_bytes = 0, structure_bytes = 0;
   std::vector<PolicyPoint> points;  // bounce policy by start bounce, then throughput policy by T
@@ -82,7 +82,7 @@ std::vector<PolicyComparison> compare_policies(const PolicyStudy& study);
 // thresholds: each finite and > 0 (parse_switch_threshold); start bounces in [1, settings.bounces].
 PolicyStudy run_policy_study(StudyRenderer& renderer, const std::string& scene, const StructureSpec& structure,
                              const std::vector<int>& start_bounces, const std::vector<float>& thresholds,
-                             const ImageSettings& settings, const Log& log, int repeats = 1);
+                             const ImageSettings& settings, const Log& log, int repeats = 3);
 
 // policy.md (both tables), policy.csv (every configuration), policy.json into dir.
 void write_policy_study(const std::string& dir, const PolicyStudy& study);
