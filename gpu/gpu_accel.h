@@ -1,4 +1,4 @@
-// A structure's std430 arrays (ls::Accel, cpu/accel.h) uploaded unchanged to the GPU, in the binding
+// A structure's std430 arrays (ls::Accel, common/structure/accel.h) uploaded unchanged to the GPU, in the binding
 // order of shaders/scene_buffers.glsl.
 #pragma once
 

@@ -2,7 +2,7 @@
 // rays' light run in shaders (trace.comp, shade.comp) with the CPU renderer's kernels
 // (common/kernels/shade_path.h); the host loops over passes and bounces and reads back the ray counts,
 // the images and the trace dispatches' timestamp times.  Same schedules, bounce semantics, random
-// numbers and outputs as ls::render (cpu/path_tracer.h); on lavapipe the same images bit for bit.
+// numbers and outputs as ls::render (cpu/render/path_tracer.h); on lavapipe the same images bit for bit.
 #pragma once
 
 #include "common/render/render_types.h"

@@ -1,5 +1,5 @@
 // linespace-gpu: the Vulkan port's command line, with linespace-cpu's subcommands and flags (docs/design.md §9;
-// cpu/cli_program.h) plus --device NAME|INDEX.  Line Space candidates are searched, rays traced and
+// cpu/app/cli_program.h) plus --device NAME|INDEX.  Line Space candidates are searched, rays traced and
 // paths shaded on the device; every figure is printed with the device's name.
 #include "cpu/app/cli_program.h"
 #include "gpu/device_list.h"

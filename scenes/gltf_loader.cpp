@@ -277,7 +277,7 @@ class GltfReader {
     return mesh;
   }
 
-  // ---- animations (common/animation.h) ----
+  // ---- animations (common/model/animation.h) ----
 
   // Key times: float, finite, >= 0, strictly increasing (glTF 2.0, animation.sampler.input).
   std::vector<float> read_times(int index, const std::string& where) const {

@@ -15,7 +15,7 @@ Scene load_scene(const std::string& spec);
 // glTF 2.0 (.gltf or .glb): meshes are objects, mesh-bearing nodes of the default scene are instances
 // (ordered by node index), baseColorFactor is the albedo, emissiveFactor makes an area light, the
 // first perspective camera is the view (else a framing camera).  The node hierarchy and every
-// animation of node transforms are kept in Scene::rig for posing (common/animation.h); the scene
+// animation of node transforms are kept in Scene::rig for posing (common/model/animation.h); the scene
 // itself is in its rest pose.
 Scene load_gltf(const std::string& path);
 
@@ -36,7 +36,7 @@ Scene load_mesh_bytes(const std::string& bytes, const std::string& format, const
 //   builtin:cornell                  the Cornell box seen through its open front, one light flush in the
 //                                    ceiling (the default scene)
 //   builtin:instances                room with 64 instances of one 51,200-triangle mesh + unique objects
-//   builtin:carousel                 animated (common/animation.h): 24 instances of two meshes riding,
+//   builtin:carousel                 animated (common/model/animation.h): 24 instances of two meshes riding,
 //                                    spinning, bobbing and pulsing, plus static unique objects
 //   builtin:generated:T:O:S          T triangles spread over O objects, seed S (scaling studies)
 Scene builtin_scene(const std::string& name);

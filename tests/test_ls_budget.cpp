@@ -1,4 +1,4 @@
-// Per-object Line Space parameters (LsBuildOptions::objects) and 2l-ls:auto (cpu/ls_budget.h): each object's
+// Per-object Line Space parameters (LsBuildOptions::objects) and 2l-ls:auto (cpu/build/ls_budget.h): each object's
 // Line Space equals the one a uniform structure gives it, the budget holds, the pilot's lazily searched
 // shafts answer like a full build, and the optimiser keeps its guarantees against brute force.
 #include "common/structure/accel.h"

@@ -1,4 +1,4 @@
-// --threads (cpu/thread_limit.h): a limit applies to every parallel call while it lives, is lifted
+// --threads (common/base/thread_limit.h): a limit applies to every parallel call while it lives, is lifted
 // after, and counts outside [0, the process's CPUs] are refused.
 #include "common/base/parallel.h"
 #include "common/base/thread_limit.h"

@@ -1229,7 +1229,7 @@ TEST_CASE("scene validation accepts instance transforms scaled by 1e-20 and 1e20
 
 namespace {
 
-// A power of two at least the largest absolute world coordinate, as cpu/surface.cpp computes it.
+// A power of two at least the largest absolute world coordinate, as common/render/surface.cpp computes it.
 float scene_scale_of(const ls::Scene& scene) {
   const ls::Bounds b = ls::world_bounds(scene);
   const glm::vec3 m3 = glm::max(glm::abs(b.lo), glm::abs(b.hi));
@@ -1285,7 +1285,7 @@ TEST_CASE("traversal: offset rays never re-hit their own triangle", "[traversal]
       size_t wrong_normals = 0, degenerate_hits = 0;
       for (size_t i = 0; i < primary.size(); ++i) {
         if (!is_hit(first[i])) continue;
-        // The hit point as cpu/surface.cpp computes it (barycentric interpolation in float); the
+        // The hit point as common/render/surface.cpp computes it (barycentric interpolation in float); the
         // geometric normal exactly (double), facing the incoming ray.
         const lsk::Hit& h = first[i];
         glm::vec3 p0, p1, p2;

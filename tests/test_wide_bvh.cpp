@@ -1,4 +1,4 @@
-// The fast CPU path (cpu/fast_tracer.h: wide SIMD BVH, four-lane triangle filter) against the scalar
+// The fast CPU path (cpu/trace/fast_tracer.h: wide SIMD BVH, four-lane triangle filter) against the scalar
 // reference kernels: every hit record bit for bit (t, u, v, ids), for closest and any hit, on the
 // built-in scenes and random ones, every structure, both widths of the order-free tree; and the
 // reference walking the farther child first against its own nearest-first walk: the Line Space's

@@ -1,5 +1,5 @@
 // `linespace-validate bound`: how much traversal work a Line Space can save at most, against what it
-// saves, on the same rays (CPU reference kernels, whose work is counted: cpu/accel.h).
+// saves, on the same rays (CPU reference kernels, whose work is counted: TraceWork, common/kernels/layouts.h).
 //
 // A lookup stops the walk at a Line Space node; what it can save is the exact work *below* that node.
 // Tracing the structure with every lookup refused (--ls-angle 0) walks exactly as its BVH does, and
@@ -8,7 +8,7 @@
 // Space whose every lookup gave the exact answer at a lookup's cost.  exact / oracle bounds the
 // speed-up of any Line Space at those nodes that answers as the exact structure does; a real one
 // saves less where lookups are refused, and can prune more only by answering differently (its
-// image error).  Work is in box tests: boxes + 2.3 x triangles + 5.7 x lookups (cpu/accel.h).
+// image error).  Work is in box tests: boxes + 2.3 x triangles + 5.7 x lookups (cpu/trace/trace_rays.h).
 #pragma once
 
 #include "common/structure/accel.h"

@@ -1,4 +1,4 @@
-// `linespace-validate budget`: the per-object choice of 2l-ls:auto (cpu/ls_budget.h) against uniform
+// `linespace-validate budget`: the per-object choice of 2l-ls:auto (cpu/build/ls_budget.h) against uniform
 // parameters of the same memory.  For each uniform 2l-ls:D:N: its bytes_ls become the
 // budget of a 2l-ls:auto, and both are rendered from each start bounce against the all-exact reference
 // with the same random numbers (the measurement `rmse` makes): RMSE and rmse_bias per start bounce, indirect MRays/s,

@@ -109,7 +109,7 @@ struct LsCounters {
 };
 
 // What a trace did, counted by the reference traversal (traverse_bvh.h): the work model of the Line
-// Space budget's pilot (cpu/ls_budget.h) and of `linespace-validate bound`.  C++ only: the shaders
+// Space budget's pilot (cpu/build/ls_budget.h) and of `linespace-validate bound`.  C++ only: the shaders
 // count nothing.  The *_in_ls part was done at nodes in a Line Space node's subtree, the LS node
 // included: the exact work below the lookups.
 struct TraceWork {

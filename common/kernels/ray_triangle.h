@@ -64,7 +64,7 @@ LS_FN TriRay make_tri_ray(IN(vec3) origin, IN(vec3) dir) {
 
 // The first half of the test: the triangle translated to the ray's origin, scaled and sheared, and
 // its three edge functions.  The CPU's fast path computes the same values four triangles at a time
-// and finishes the survivors with ray_triangle_plane (cpu/triangle_blocks.h).
+// and finishes the survivors with ray_triangle_plane (cpu/trace/triangle_blocks.h).
 struct TriEdges {
   vec3 a;    // p0 - origin, scaled by 2^ks (the plane distance is taken from it)
   int ks;

@@ -1,9 +1,9 @@
-// The path tracer's per-path steps (cpu/path_tracer.h), once for CPU and GPU (docs/design.md §4): start a
+// The path tracer's per-path steps (cpu/render/path_tracer.h), once for CPU and GPU (docs/design.md §4): start a
 // path at the camera, shade the hit of its segment (surface, MIS-weighted emission, a light sample for
 // next-event estimation with its shadow ray, the next direction) and add a shadow ray's light.
 //
 // Meant to be included where the shading buffers are in scope under these names: inside
-// lsk::ShadeContext (cpu/shade_context.h) on the CPU, at global scope in gpu/shaders/*.comp:
+// lsk::ShadeContext (common/render/shade_context.h) on the CPU, at global scope in gpu/shaders/*.comp:
 //   shade_instances[] (ShadeInstance), shade_vertices[] (ShadeVertex), shade_triangles[]
 //   (ShadeTriangle), materials[] (ShadeMaterial), lights[] (ShadeLight), light_cdf[] (float,
 //   inclusive, last == 1) and `shade` (ShadeParams).

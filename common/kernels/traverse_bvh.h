@@ -2,7 +2,7 @@
 //
 // A *context* file: it includes nothing and opens no namespace, because it is included where the
 // scene's buffers are in scope — in a shader after the buffer declarations, in C++ inside the struct
-// lsk::TraceContext (cpu/trace_context.h) whose pointer members carry the same names:
+// lsk::TraceContext (common/structure/trace_context.h) whose pointer members carry the same names:
 //   nodes[]          BvhNode   every object BVH (2L) or the one flat BVH (F), children adjacent
 //   tris[]           Triangle  in BVH order
 //   tri_ids[]        uint      triangle id within its mesh, per triangle in BVH order
