@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
 """Self-test for check_includes.py: runs it on tiny fake trees and checks exit codes/output."""
+# named-paths: examples (the fake trees' files, for check_named_paths.py)
 import os, subprocess, sys, tempfile
 
 CHECKER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "check_includes.py")
