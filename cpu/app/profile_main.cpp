@@ -19,9 +19,9 @@
 
 #include <tbb/global_control.h>
 
+#include <charconv>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -38,6 +38,16 @@ int usage() {
   return 2;
 }
 
+// A whole decimal count in [lo, hi], or InputError naming the flag ("3x", "-1", "abc" are refused).
+uint32_t count_flag(const char* flag, const std::string& text, uint32_t lo, uint32_t hi) {
+  uint32_t v = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (error != std::errc() || end != text.data() + text.size() || v < lo || v > hi)
+    throw ls::InputError(std::string(flag) + " must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "], not '" + text + "'");
+  return v;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -50,14 +60,15 @@ int main(int argc, char** argv) try {
   std::string embree_isa = "best";  // valgrind 3.19 has no AVX-512: under it, "best" is Embree's avx2
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--repeat" && i + 1 < argc) repeat = std::atoi(argv[++i]);
+    if (a == "--repeat" && i + 1 < argc) repeat = int(count_flag("--repeat", argv[++i], 1, 1000));
     else if (a == "--reference") path = Path::Reference;
     else if (a == "--embree") path = Path::Embree;
     else if (a == "--any-hit") query = Query::AnyHit;
     else if (a == "--occlusion") query = Query::Occlusion;
     else if (a == "--lookups") query = Query::Lookups;
     else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
-    else if (a == "--ls-min-triangles" && i + 1 < argc) options.ls.min_triangles = uint32_t(std::atoi(argv[++i]));
+    else if (a == "--ls-min-triangles" && i + 1 < argc)
+      options.ls.min_triangles = count_flag("--ls-min-triangles", argv[++i], 0, UINT32_MAX);
     else if (a == "--ls-behind" && i + 1 < argc) lookup.behind = ls::parse_ls_behind(argv[++i]);  // else InputError
     else if (a == "--ls-leave-reach" && i + 1 < argc) lookup.leave_reach = ls::parse_ls_leave_reach(argv[++i]);
     else if (a == "--skip" && i + 1 < argc) {
@@ -66,10 +77,9 @@ int main(int argc, char** argv) try {
       else if (what == "lookups") lookup.skip = ls::LsSkip::Lookups;
       else return usage();
     }
-    else if (a == "--exact-width" && i + 1 < argc) options.exact_width = std::atoi(argv[++i]);  // 4 or 8, else InputError
+    else if (a == "--exact-width" && i + 1 < argc) options.exact_width = int(count_flag("--exact-width", argv[++i], 4, 8));  // 4 or 8, else InputError
     else return usage();
   }
-  if (repeat < 1) return usage();
   if (lookup.skip != ls::LsSkip::Nothing && (path != Path::Fast || query == Query::AnyHit || query == Query::Lookups)) {
     std::fprintf(stderr, "linespace-profile: --skip times the fast path's closest-hit and occlusion queries only\n");
     return 2;
