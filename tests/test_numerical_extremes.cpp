@@ -1,6 +1,7 @@
 // Numerical extremes end to end: builtin:cornell scaled by 1e-20 .. 1e20 and moved 1e6 away renders
 // with finite pixels, and (where float can still represent the scene) the same picture as at scale 1.
 #include "common/render/render_types.h"
+#include "cpu/build/build_accel.h"
 #include "cpu/build/build_structures.h"
 #include "cpu/render/path_tracer.h"
 #include "scenes/load_scene.h"
@@ -67,6 +68,40 @@ TEST_CASE("a power-of-two scale changes no decision: the image is the scale-1 im
     for (size_t i = 0; i < r.total.size(); ++i)
       worst = std::max(worst, double(glm::length(r.total[i] - reference.total[i]) / (glm::length(reference.total[i]) + 1e-3f)));
     CHECK(worst < 1e-4);
+  }
+}
+
+// The SAH's costs are areas: squared, times a triangle count, in float. At 2^64 they overflowed and
+// at 2^-64 they fell to subnormals, so the tree (and every Line Space answer with it) changed with
+// the scale. Every box must be the scale-1 box times the scale, every other field equal.
+TEST_CASE("a power-of-two scale builds the scale-1 BVH and Line Space, every box scaled", "[extremes]") {
+  AccelOptions options;
+  options.ls.min_triangles = 0;
+  for (const char* name : {"f-ls:4:4", "2l-ls:2:4"}) {
+    const Accel reference = build_accel(builtin_scene("cornell"), parse_structure(name), options);
+    REQUIRE(!reference.ls_nodes.empty());
+    for (const float scale : {0x1p-100f, 0x1p-64f, 0x1p64f, 0x1p100f}) {
+      Scene scene = builtin_scene("cornell");
+      scale_and_offset(scene, scale, glm::vec3(0.0f));
+      const Accel scaled = build_accel(scene, parse_structure(name), options);
+      INFO(name << " at scale " << scale);
+      // The scale is the instances' (scale_and_offset): a flat BVH's boxes scale, a two-level
+      // structure's object BVHs do not and its top level's do.
+      auto differing = [](const std::vector<lsk::BvhNode>& got, const std::vector<lsk::BvhNode>& want, float s) {
+        if (got.size() != want.size()) return std::max(got.size(), want.size());
+        size_t differ = 0;
+        for (size_t i = 0; i < got.size(); ++i)
+          differ += got[i].lo != want[i].lo * s || got[i].hi != want[i].hi * s || got[i].first != want[i].first ||
+                    got[i].count != want[i].count;
+        return differ;
+      };
+      const bool flat = reference.top_nodes.size() <= 1;
+      CHECK(differing(scaled.nodes, reference.nodes, flat ? scale : 1.0f) == 0);
+      CHECK(differing(scaled.top_nodes, reference.top_nodes, flat ? 1.0f : scale) == 0);
+      CHECK(scaled.tri_ids == reference.tri_ids);
+      CHECK(scaled.node_ls == reference.node_ls);
+      CHECK(scaled.ls_candidates == reference.ls_candidates);
+    }
   }
 }
 

@@ -16,6 +16,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
+#include <cmath>
 #include <limits>
 #include <memory>
 
@@ -30,9 +31,20 @@ constexpr uint32_t kParallelSubtrees = 1024;
 constexpr int kMaxBins = 64;
 constexpr uint32_t kDenseBinning = 16;  // ranges at least this large initialise all bins (BinSet::make_dense)
 
-float half_area(const Bounds& b) {
+// The SAH's half areas are taken in units of a power of two near the range's largest extent (`unit`
+// multiplies every coordinate first): scaling by a power of two is exact, so a scene scaled by 2^p
+// gets the same costs bit for bit, hence the same tree, and the costs neither overflow (extents
+// past 2^63 squared, the count on top) nor fall to subnormals (extents under 2^-63).
+float area_unit(const Bounds& b) {
+  double extent = 0.0;
+  for (int a = 0; a < 3; ++a) extent = std::max(extent, double(b.hi[a]) - double(b.lo[a]));
+  if (!(extent > 0.0) || !std::isfinite(extent)) return 1.0f;
+  return std::ldexp(1.0f, std::clamp(-std::ilogb(extent), -126, 126));
+}
+
+float half_area(const Bounds& b, float unit) {
   if (b.empty()) return 0.0f;
-  const glm::vec3 e = b.extent();
+  const glm::vec3 e = b.hi * unit - b.lo * unit;
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
@@ -87,10 +99,10 @@ struct Box4 {
   }
 };
 
-// half_area of a box, as the scalar rule: 0 when empty (lo.x > hi.x, which is e.x < 0 of the exact
+// half_area of a box in `unit`s, as the scalar rule: 0 when empty (lo.x > hi.x, which is e.x < 0 of the exact
 // difference), else e.x * e.y + e.y * e.z + e.z * e.x of its extent, summed in that order.
-float half_area4(const Box4& b) {
-  const Float4 e = b.hi - b.lo;
+float half_area4(const Box4& b, const Float4& unit) {
+  const Float4 e = b.hi * unit - b.lo * unit;
   const Float4 products = e * xsimd::swizzle(e, xsimd::batch_constant<xsimd::batch<uint32_t, Simd4Arch>, 1, 2, 0, 3>());
   alignas(16) float ev[4], pv[4];
   e.store_aligned(ev);
@@ -302,6 +314,8 @@ class Builder {
     BinSet set;
     bin(set, begin, end, cb, scale);
 
+    const float unit = area_unit(info.box());
+    const Float4 unit4(unit);
     float best_cost = std::numeric_limits<float>::infinity();
     int best_axis = -1, best_bin = 0;
     for (int a = 0; a < 3; ++a) {
@@ -321,19 +335,19 @@ class Builder {
       for (int j = k - 1; j > 0; --j) {
         grow(acc, bins[j]);
         count += set.count[a][bins[j]];
-        right_cost[j] = half_area4(acc) * float(count);
+        right_cost[j] = half_area4(acc, unit4) * float(count);
       }
       acc = Box4{};
       count = 0;
       for (int j = 0; j + 1 < k; ++j) {
         grow(acc, bins[j]);
         count += set.count[a][bins[j]];
-        const float cost = half_area4(acc) * float(count) + right_cost[j + 1];
+        const float cost = half_area4(acc, unit4) * float(count) + right_cost[j + 1];
         if (cost < best_cost) { best_cost = cost; best_axis = a; best_bin = bins[j]; }
       }
     }
     if (best_axis < 0) return end;
-    const float parent_area = half_area(info.box());
+    const float parent_area = half_area(info.box(), unit);
     const float split_cost = parent_area > 0.0f ? options_.traversal_cost + best_cost / parent_area : float(n);
     if (n <= uint32_t(options_.max_leaf_size) && float(n) <= split_cost) return begin;  // a leaf is cheaper
     const float lo = cb.lo[best_axis], sc = scale[best_axis];
