@@ -374,6 +374,58 @@ TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a nam
   CHECK(bad.out.empty());
 }
 
+TEST_CASE("bench and linespace-profile --embree refuse rays Embree cannot take; bench warns where Embree answers otherwise",
+          "[cli]") {
+  // Embree 3 aborts on a ray with tmin < 0 or a component past 1.844e18 (its assertions).
+  const std::array<std::pair<const char*, lsk::Ray>, 3> outside = {{
+      {"tmin -10", lsk::Ray{glm::vec3(0.0f, 1.0f, 3.0f), -10.0f, glm::vec3(0.0f, 0.0f, -1.0f), 1e30f}},
+      {"origin 3e38", lsk::Ray{glm::vec3(0.0f, 1.0f, 3e38f), 0.0f, glm::vec3(0.0f, 0.0f, -1.0f), 1e30f}},
+      {"direction 1e38", lsk::Ray{glm::vec3(0.0f, 1.0f, 3.0f), 0.0f, glm::vec3(0.0f, 0.0f, -1e38f), 1e30f}},
+  }};
+  for (const auto& [what, ray] : outside) {
+    INFO(what);
+    const fs::path rays = temp("embree_domain.rays");
+    fs::create_directories(rays.parent_path());
+    ls::write_rays(rays.string(), {ray});
+    const Run bench = run("bench --scene builtin:cornell --structures bvh --repeat 1 --rays " + rays.string());
+    INFO(bench.err);
+    CHECK(bench.status == 2);
+    CHECK(line_count(bench.err) == 1);
+    CHECK(bench.err.find("Embree 3 takes rays with 0 <= tmin") != std::string::npos);
+    const Run profile = run_program(LINESPACE_PROFILE, "builtin:cornell bvh " + rays.string() + " --embree", "cli_test");
+    INFO(profile.err);
+    CHECK(profile.status == 2);
+    CHECK(profile.err.find("Embree 3 takes rays with 0 <= tmin") != std::string::npos);
+  }
+  // One triangle 1e-20 across: Embree misses about half of the random rays that hit it (its
+  // kernels' tolerances); at scale 1 the two agree.
+  for (const float scale : {1.0f, 1e-20f}) {
+    INFO("scale " << scale);
+    const fs::path obj = temp("one_triangle.obj");
+    char text[128];
+    std::snprintf(text, sizeof text, "v 0 0 0\nv %g 0 0\nv 0 %g 0\nf 1 2 3\n", double(scale), double(scale));
+    write_text(obj, text);
+    const std::string args = "bench --scene " + obj.string() + " --structures bvh --kind random --count 2000 --repeat 1";
+    const Run json = run(args + " --json");
+    INFO(json.err);
+    REQUIRE(json.status == 0);
+    const auto j = nlohmann::json::parse(json.out);
+    CHECK(j["embree_compared_with"] == "bvh");
+    const Run table = run(args);
+    if (scale == 1.0f) {
+      CHECK(j["embree_disagreement"].get<double>() == 0.0);
+      CHECK(table.out.find("warning: Embree's hits differ") == std::string::npos);
+    } else {
+      CHECK(j["embree_disagreement"].get<double>() > 0.2);
+      CHECK(table.out.find("warning: Embree's hits differ from bvh's") != std::string::npos);
+    }
+  }
+  // Without an exact structure there is nothing to compare with: null.
+  const Run ls = run("bench --scene builtin:cornell --structures f-ls:3:3 --count 500 --repeat 1 --json");
+  REQUIRE(ls.status == 0);
+  CHECK(nlohmann::json::parse(ls.out)["embree_disagreement"].is_null());
+}
+
 TEST_CASE("render writes every image and a report", "[cli]") {
   const fs::path out = temp("render");
   fs::remove_all(out);

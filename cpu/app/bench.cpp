@@ -13,6 +13,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <memory>
 
 namespace ls {
@@ -28,11 +29,18 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   result.exact_width = options.exact_width;
   result.any_hit = any_hit;
 
-  // The rays, a hit array, the structures and Embree's scene stay in memory together for the timed
+  const std::string outside = embree_ray_domain_error(rays.data(), rays.size());
+  if (!outside.empty()) throw InputError("bench times Embree on the same rays: " + outside);
+  // The first exact structure's hits are kept to check Embree's against (it answers as the BVH does).
+  const auto exact = std::find_if(structures.begin(), structures.end(), [](const StructureSpec& s) { return !s.line_space(); });
+  const size_t compared = size_t(exact - structures.begin());
+  const bool compare = exact != structures.end();
+
+  // The rays, the hit arrays, the structures and Embree's scene stay in memory together for the timed
   // runs: each structure, then Embree, is refused over what the ones before it left of the budget
   // (memory_budget.h), so that together they stay within it.
   const size_t budget = memory_budget(options.limits.max_memory);
-  size_t held = ray_bytes(rays.size(), false, 1);  // then the structures built so far, fast paths included
+  size_t held = ray_bytes(rays.size(), false, compare ? 2 : 1);  // then the structures built so far, fast paths included
   check_held_budget("bench: " + std::to_string(rays.size()) + " rays and their hits", held, options.limits.max_memory,
                     "use fewer rays (--count) or raise --max-memory");
   std::vector<Accel> built;
@@ -78,7 +86,15 @@ BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, con
   runs.push_back([&] { embree.trace(rays.data(), hits.data(), rays.size(), any_hit); });
 
   std::vector<std::vector<double>> seconds(runs.size());
-  for (auto& run : runs) run();  // warm caches and thread pools once
+  std::vector<lsk::Hit> exact_hits;
+  for (size_t i = 0; i < runs.size(); ++i) {  // warm caches and thread pools once
+    runs[i]();
+    if (compare && i == 2 * compared) exact_hits = hits;  // its fast path
+  }
+  result.embree_compared_with = compare ? exact->name() : "";
+  result.embree_disagreement =
+      compare ? embree_disagreement(hits.data(), exact_hits.data(), rays.size(), any_hit) : std::numeric_limits<double>::quiet_NaN();
+  exact_hits = {};
   for (int r = 0; r < result.repeats; ++r)
     for (size_t i = 0; i < runs.size(); ++i) {
       const auto start = std::chrono::steady_clock::now();

@@ -38,9 +38,14 @@ struct BenchResult {
   int exact_width = 0;
   bool any_hit = false;
   std::vector<BenchEntry> results;  // the structures in the order asked, Embree last
+  // embree_disagreement (embree_tracer.h) against the first exact structure benched, named here;
+  // empty and NaN when none is.
+  std::string embree_compared_with;
+  double embree_disagreement = 0.0;
 };
 
-// any_hit: occlusion queries (rtcOccluded1 for Embree), e.g. for shadow rays.  embree_isa: one of
+// any_hit: occlusion queries (rtcOccluded1 for Embree), e.g. for shadow rays.  Rays outside Embree's
+// domain (embree_ray_domain_error) are an InputError: Embree would abort on them.  embree_isa: one of
 // embree_isa_names() (embree_tracer.h).
 BenchResult run_bench(const Scene& scene, const std::vector<lsk::Ray>& rays, const std::vector<StructureSpec>& structures,
                       int repeats, const AccelOptions& options = {}, const LsLookup& lookup = {}, bool any_hit = false,

@@ -87,6 +87,10 @@ int main(int argc, char** argv) try {
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const ls::Scene scene = ls::load_scene(argv[1]);
   const std::vector<lsk::Ray> rays = ls::read_rays(argv[3]);
+  if (path == Path::Embree) {
+    const std::string outside = ls::embree_ray_domain_error(rays.data(), rays.size());
+    if (!outside.empty()) throw ls::InputError(outside);
+  }
   std::vector<lsk::Hit> hits(rays.size());
   std::function<void()> run;
   ls::Accel accel;

@@ -18,7 +18,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -199,6 +201,36 @@ const std::string& EmbreeTracer::isa() const { return impl_->isa; }
 size_t EmbreeTracer::bytes() const {
   const int64_t b = impl_->bytes.load(std::memory_order_relaxed);
   return b > 0 ? size_t(b) : 0;
+}
+
+std::string embree_ray_domain_error(const lsk::Ray* rays, size_t count) {
+  constexpr float kLarge = 1.844E18f;  // Embree's FLT_LARGE
+  auto within = [&](const glm::vec3& v) { return std::abs(v.x) <= kLarge && std::abs(v.y) <= kLarge && std::abs(v.z) <= kLarge; };
+  for (size_t i = 0; i < count; ++i) {
+    const lsk::Ray& r = rays[i];
+    const bool ok = within(r.origin) && within(r.dir) && r.tmin >= 0.0f && r.tmin <= r.tmax;
+    if (ok) continue;
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "Embree 3 takes rays with 0 <= tmin <= tmax and origin and direction components within +-1.844e18; "
+                  "ray %zu has origin (%g, %g, %g), direction (%g, %g, %g), tmin %g, tmax %g",
+                  i, double(r.origin.x), double(r.origin.y), double(r.origin.z), double(r.dir.x), double(r.dir.y),
+                  double(r.dir.z), double(r.tmin), double(r.tmax));
+    return text;
+  }
+  return {};
+}
+
+double embree_disagreement(const lsk::Hit* embree, const lsk::Hit* ours, size_t count, bool any_hit) {
+  if (count == 0) return 0.0;
+  size_t differ = 0;
+  for (size_t i = 0; i < count; ++i) {
+    const bool e = std::isfinite(embree[i].t), o = std::isfinite(ours[i].t);
+    if (e != o) ++differ;
+    else if (e && !any_hit && std::abs(embree[i].t - ours[i].t) > 1e-3f * std::max(std::abs(embree[i].t), std::abs(ours[i].t)))
+      ++differ;
+  }
+  return double(differ) / double(count);
 }
 
 void EmbreeTracer::trace(const lsk::Ray* rays, lsk::Hit* hits, size_t count, bool any_hit) const {

@@ -27,6 +27,16 @@ struct EmbreeOverBudget : InputError {
   using InputError::InputError;
 };
 
+// Embree 3 takes a ray only with 0 <= tmin <= tmax and every origin and direction component within
+// +-1.844e18 (FLT_LARGE, RayK::valid()); its kernels abort on others.  Empty when every ray is in
+// that domain, else the first one outside it, described, for an InputError.
+std::string embree_ray_domain_error(const lsk::Ray* rays, size_t count);
+
+// The share of rays whose Embree hit is not ours: a hit against a miss, or (closest hit) a t more
+// than 1e-3 of its magnitude apart.  Embree drops triangles past +-1.844e18 and misses at tiny
+// scales, where its timing would be of other work.
+double embree_disagreement(const lsk::Hit* embree, const lsk::Hit* ours, size_t count, bool any_hit);
+
 class EmbreeTracer {
  public:
   // isa: one of embree_isa_names(); an unknown name is an InputError.  max_bytes: 0 for no limit,
