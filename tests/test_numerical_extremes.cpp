@@ -105,6 +105,26 @@ TEST_CASE("a power-of-two scale builds the scale-1 BVH and Line Space, every box
   }
 }
 
+// Mesh files have no camera: framing_camera puts one before the scene's bounds. In float their squared
+// extent overflowed past 1.8e19 (a camera at infinity: a blank image, exit 0) and underflowed below
+// 1e-19 (a camera 1 away from a scene 1e-25 across).
+TEST_CASE("the framing camera of a scene scaled by a power of two is the scale-1 camera scaled", "[extremes]") {
+  const Camera reference = framing_camera(builtin_scene("cornell"));
+  for (const float scale : {0x1p-90f, 0x1p-64f, 0x1p64f, 0x1p70f, 0x1p100f}) {
+    Scene scene = builtin_scene("cornell");
+    scale_and_offset(scene, scale, glm::vec3(0.0f));
+    const Camera cam = framing_camera(scene);
+    INFO("scale " << scale);
+    CHECK(cam.position == reference.position * scale);
+    CHECK(cam.target == reference.target * scale);
+    CHECK(cam.yfov == reference.yfov);
+  }
+  // 1e38 across: the camera would stand past float's range.
+  Scene huge = builtin_scene("cornell");
+  scale_and_offset(huge, 1e38f, glm::vec3(0.0f));
+  CHECK_THROWS_WITH(framing_camera(huge), Catch::Contains("cannot be placed in float"));
+}
+
 TEST_CASE("scenes moved 1e6 away render finite pixels, and so do scenes float cannot resolve", "[extremes]") {
   const RenderResult reference = render_small(builtin_scene("cornell"));
   {

@@ -2,6 +2,7 @@
 
 
 #include <cmath>
+#include <cstdio>
 
 namespace ls {
 
@@ -82,15 +83,24 @@ void validate_scene(const Scene& scene) {
 }
 
 Camera framing_camera(const Scene& scene) {
+  // In double: the extent's squared length overflows float past 1.8e19 (and underflows below 1e-19),
+  // which put the camera at infinity or at distance 1 from a tiny scene, silently.
   const Bounds b = world_bounds(scene);
+  const glm::dvec3 lo(b.lo), hi(b.hi);
+  const glm::dvec3 centre = 0.5 * (lo + hi);
   Camera cam;
-  cam.target = b.centre();
-  const glm::vec3 e = b.extent();
-  const float radius = 0.5f * glm::length(e);
   cam.yfov = 0.7f;
-  const float dist = radius / std::tan(0.5f * cam.yfov) * 1.1f;
-  cam.position = cam.target + glm::vec3(0.0f, 0.0f, dist > 0.0f ? dist : 1.0f);
+  const double radius = 0.5 * glm::length(hi - lo);
+  const double dist = radius / std::tan(0.5 * double(cam.yfov)) * 1.1;
+  cam.target = glm::vec3(centre);
+  cam.position = glm::vec3(centre + glm::dvec3(0.0, 0.0, dist > 0.0 ? dist : 1.0));
   cam.up = glm::vec3(0.0f, 1.0f, 0.0f);
+  if (!std::isfinite(cam.position.z) || cam.position == cam.target)
+  {
+    char text[160];
+    std::snprintf(text, sizeof text, "a camera framing this scene (%g in radius) cannot be placed in float", radius);
+    throw InputError(std::string(text) + ": the scene needs a camera of its own (glTF) or a smaller scale");
+  }
   return cam;
 }
 
