@@ -46,7 +46,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 33> cases = {
+  const std::array<std::string, 38> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -80,6 +80,12 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "bench --exact-width 0 --count 10",
       "build --threads -1",
       "bench --threads 1048576 --count 10",  // more threads than this process's CPUs
+      // NaN compares false with every bound, so range checks once let it through.
+      "render --ls-angle nan --size 8x8 --out " + temp("r").string(),
+      "build --max-memory nan",
+      "build --max-memory inf",
+      "build --structure 2l-ls:auto --ls-budget nan",
+      "rays --max-memory nan --count 10 --out " + temp("x.rays").string(),
   };
   for (const std::string& args : cases) {
     const Run r = run(args);

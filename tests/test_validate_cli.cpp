@@ -21,7 +21,7 @@ fs::path temp(const std::string& name) { return temp_path("validate_cli", name);
 TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 with a one-line reason", "[cli]") {
   fs::create_directories(temp(""));
   { std::ofstream(temp("broken.gltf")) << "{ not json"; }
-  const std::array<std::string, 37> cases = {
+  const std::array<std::string, 41> cases = {
       "rmse --scene /nonexistent.glb",
       "rmse --scene " + temp("broken.gltf").string(),
       "rmse --scene builtin:nothing",
@@ -51,6 +51,10 @@ TEST_CASE("linespace-validate: bad scenes, structures, sizes and flags exit 2 wi
       "policy --start-bounces 4 --bounces 3",
       "policy --structure octree",
       "policy --repeat 0",
+      "rmse --heatmap-max nan",  // NaN compares false with every bound
+      "paper --heatmap-max nan",
+      "sweep --ls-angle nan",
+      "sweep --angles nan",
       "rmse --threads -2",
       "sweep --threads 1048576",  // more threads than this process's CPUs
       "bound --structures bvh",   // an exact structure has nothing to bound

@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
   rmse_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
   rmse_cmd->add_option("--out", out_dir, "folder for rmse.{md,csv,json}, heat-maps and images")->default_val("out/rmse");
   rmse_cmd->add_option("--heatmap-max", heatmap_max, "per-pixel error at the top of the heat-map's ramp")
-      ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
+      ->capture_default_str()->check(finite_range(1e-6, 1.0));
   image_flags.add_to(rmse_cmd);
   ls_flags.add_to(rmse_cmd);
   threads_flag.add_to(rmse_cmd);
@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
   paper_cmd->add_option("--device", device, "cpu, gpu or gpu:NAME|INDEX (a Vulkan device)")->capture_default_str();
   paper_cmd->add_option("--out", out_dir, "folder for paper.{md,json} and each scene's rmse files")->default_val("out/paper");
   paper_cmd->add_option("--heatmap-max", heatmap_max, "per-pixel error at the top of the heat-map's ramp")
-      ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
+      ->capture_default_str()->check(finite_range(1e-6, 1.0));
   image_flags.add_to(paper_cmd);
   ls_flags.add_to(paper_cmd);
   threads_flag.add_to(paper_cmd);

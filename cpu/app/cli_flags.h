@@ -9,12 +9,28 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace ls {
+
+// A finite number in [lo, hi].  CLI::Range lets NaN through: every comparison with it is false
+// (--ls-angle nan accepted every lookup, --max-memory nan skipped the budget).
+inline CLI::Validator finite_range(double lo, double hi) {
+  const std::string range = "[" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size()) return "'" + text + "' is not a number";
+        if (!(v >= lo && v <= hi)) return "Value " + text + " not in range " + range + " (a finite number)";
+        return {};
+      },
+      "FLOAT in " + range);
+}
 
 struct Size {
   uint32_t width = 512, height = 512;
@@ -83,7 +99,7 @@ struct LsFlags {
         refused_flags.emplace_back(flag, app->add_option(flag, refused_value)->group(""));  // group "": not in --help
     }
     app->add_option("--ls-angle", angle, "refusal angle in degrees between ray and extrapolated normal (0: refuse all)")
-        ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+        ->capture_default_str()->check(finite_range(0.0, 90.0));
     app->add_option("--ls-behind", behind,
                     "a plane hit behind the origin: exact (traverse the subtree), empty (the reverse shaft may answer "
                     "\"nothing ahead\", else traverse) or reverse (the reverse shaft's candidate answers)")
@@ -108,9 +124,9 @@ struct LsFlags {
     app->add_option("--ls-candidates", candidates, "compact (1/2/4-byte local index) or paper (4 bytes)")
         ->capture_default_str()->check(CLI::IsMember({"compact", "paper"}));
     app->add_option("--max-memory", max_memory_mb, "refuse a structure or render estimated above this many MB (0: half of RAM)")
-        ->check(CLI::Range(0.0, 1e9));
+        ->check(finite_range(0.0, 1e9));
     app->add_option("--ls-budget", ls_budget_mb, "2l-ls:auto: MB of Line Space (bytes_ls) to spend, D and N chosen per object")
-        ->check(CLI::Range(0.0, 1e9));
+        ->check(finite_range(0.0, 1e9));
     app->add_option("--ls-budget-rays", ls_budget_rays, "2l-ls:auto: pilot diffuse rays that measure each object's error")
         ->capture_default_str()->check(CLI::Range(size_t(1), size_t(1) << 24));
   }

@@ -100,7 +100,7 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
   c.rays->add_option("--seed", v.seed)->capture_default_str();
   c.rays->add_option("--out", v.out_path, "ray file to write")->required();
   c.rays->add_option("--max-memory", v.ls.max_memory_mb, "refuse a ray count estimated above this many MB (0: half of RAM)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(finite_range(0.0, 1e9));
 
   c.render = app.add_subcommand("render", "path trace; write EXRs per bounce, a PNG and report.json");
   common(c.render, true);
