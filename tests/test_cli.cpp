@@ -432,6 +432,29 @@ TEST_CASE("bench and linespace-profile --embree refuse rays Embree cannot take; 
   CHECK(nlohmann::json::parse(ls.out)["embree_disagreement"].is_null());
 }
 
+TEST_CASE("an output path that is a directory exits 2 naming it, and leaves no temporary file", "[cli]") {
+  const fs::path dir = temp("outputs");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "hits_here");
+  fs::create_directories(dir / "render" / "total.exr");
+  REQUIRE(run("rays --scene builtin:cornell --count 100 --out " + (dir / "r.rays").string()).status == 0);
+  for (const auto& [args, path] : std::array<std::pair<std::string, fs::path>, 3>{{
+           {"trace --scene builtin:cornell --structure bvh --rays " + (dir / "r.rays").string() + " --hits " +
+                (dir / "hits_here").string(), dir / "hits_here"},
+           {"rays --scene builtin:cornell --count 10 --out " + (dir / "hits_here").string(), dir / "hits_here"},
+           {"render --scene builtin:cornell --size 8x8 --spp 1 --quiet --out " + (dir / "render").string(),
+            dir / "render" / "total.exr"},
+       }}) {
+    const Run r = run(args);
+    INFO(args << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find("cannot write '" + path.string() + "': it is a directory") != std::string::npos);
+    for (const auto& entry : fs::recursive_directory_iterator(dir))
+      CHECK(entry.path().string().find(".partial") == std::string::npos);
+  }
+}
+
 TEST_CASE("render writes every image and a report", "[cli]") {
   const fs::path out = temp("render");
   fs::remove_all(out);

@@ -1,6 +1,7 @@
 #include "common/base/ray_files.h"
 
 #include "common/base/interrupt.h"
+#include "common/base/replace_file.h"
 #include "common/model/scene.h"
 
 #include <cmath>
@@ -41,7 +42,7 @@ void write_records(const std::string& path, const std::vector<T>& records, const
     out.write(reinterpret_cast<const char*>(records.data()), std::streamsize(records.size() * sizeof(T)));
     if (!out) throw InputError("cannot write " + std::string(what) + " file '" + path + "'");
   }
-  std::filesystem::rename(temp, path);
+  replace_file(temp, path);
 }
 
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }

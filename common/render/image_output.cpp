@@ -1,6 +1,7 @@
 #include "common/render/image_output.h"
 
 #include "common/base/interrupt.h"
+#include "common/base/replace_file.h"
 #include "common/model/scene.h"
 
 #include <ImfChannelList.h>
@@ -48,7 +49,12 @@ void write_renamed(const std::string& path, WriteTemp&& write_temp) {
     std::filesystem::remove(temp, ec);
     throw std::runtime_error("cannot write '" + path + "': " + first_line(error));
   }
-  std::filesystem::rename(temp, path);
+  try {
+    replace_file(temp, path);
+  } catch (...) {
+    set_partial_file(nullptr);  // temp is gone, and its name with this frame
+    throw;
+  }
   set_partial_file(nullptr);
 }
 

@@ -1,6 +1,7 @@
 #include "common/render/render_output.h"
 
 #include "common/base/interrupt.h"
+#include "common/base/replace_file.h"
 #include "common/base/system_info.h"
 #include "common/base/thread_limit.h"
 #include "common/render/image_output.h"
@@ -139,7 +140,12 @@ void write_json_file(const std::string& path, const nlohmann::json& report, bool
       throw InputError("cannot write '" + path + "'");
     }
   }
-  std::filesystem::rename(temp, path);
+  try {
+    replace_file(temp, path);
+  } catch (...) {
+    set_partial_file(nullptr);  // temp is gone, and its name with this frame
+    throw;
+  }
   set_partial_file(nullptr);
 }
 
