@@ -29,13 +29,15 @@
 
 namespace {
 
-int usage() {
-  std::fprintf(stderr,
+// To stderr with exit 2 (bad usage, after `why`), or to stdout with exit 0 (--help).
+int usage(const std::string& why = "", bool help = false) {
+  if (!why.empty()) std::fprintf(stderr, "linespace-profile: %s\n", why.c_str());
+  std::fprintf(help ? stdout : stderr,
                "usage: linespace-profile SCENE STRUCTURE RAYS [--repeat K] [--reference | --embree] [--any-hit | "
                "--occlusion | --lookups] [--ls-min-triangles M] [--ls-behind exact|empty|reverse] [--ls-leave-reach P] "
-               "[--skip refused-walks|lookups] "
+               "[--skip refused-walks|lookups] [--ls-budget MB] "
                "[--embree-isa ISA] [--exact-width 4|8]\n");
-  return 2;
+  return help ? 0 : 2;
 }
 
 // A whole decimal count in [lo, hi], or InputError naming the flag ("3x", "-1", "abc" are refused).
@@ -51,7 +53,9 @@ uint32_t count_flag(const char* flag, const std::string& text, uint32_t lo, uint
 }  // namespace
 
 int main(int argc, char** argv) try {
-  if (argc < 4) return usage();
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return usage("", true);
+  if (argc < 4) return usage("SCENE, STRUCTURE and RAYS are required");
   int repeat = 1;
   enum class Path { Fast, Reference, Embree } path = Path::Fast;
   enum class Query { Closest, AnyHit, Occlusion, Lookups } query = Query::Closest;
@@ -61,24 +65,35 @@ int main(int argc, char** argv) try {
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--repeat" && i + 1 < argc) repeat = int(count_flag("--repeat", argv[++i], 1, 1000));
-    else if (a == "--reference") path = Path::Reference;
-    else if (a == "--embree") path = Path::Embree;
+    else if (a == "--reference" || a == "--embree") {
+      const Path asked = a == "--reference" ? Path::Reference : Path::Embree;
+      if (path != Path::Fast && path != asked) return usage("--reference and --embree: one path at a time");
+      path = asked;
+    }
     else if (a == "--any-hit") query = Query::AnyHit;
     else if (a == "--occlusion") query = Query::Occlusion;
     else if (a == "--lookups") query = Query::Lookups;
     else if (a == "--embree-isa" && i + 1 < argc) embree_isa = argv[++i];
     else if (a == "--ls-min-triangles" && i + 1 < argc)
       options.ls.min_triangles = count_flag("--ls-min-triangles", argv[++i], 0, UINT32_MAX);
+    else if (a == "--ls-budget" && i + 1 < argc) {  // 2l-ls:auto's MB of Line Space
+      const std::string text = argv[++i];
+      double mb = 0.0;
+      const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), mb);
+      if (error != std::errc() || end != text.data() + text.size() || !(mb > 0.0 && mb <= 1e9))
+        throw ls::InputError("--ls-budget must be MB in (0, 1e9], not '" + text + "'");
+      options.plan.budget = size_t(mb * 1e6);
+    }
     else if (a == "--ls-behind" && i + 1 < argc) lookup.behind = ls::parse_ls_behind(argv[++i]);  // else InputError
     else if (a == "--ls-leave-reach" && i + 1 < argc) lookup.leave_reach = ls::parse_ls_leave_reach(argv[++i]);
     else if (a == "--skip" && i + 1 < argc) {
       const std::string what = argv[++i];
       if (what == "refused-walks") lookup.skip = ls::LsSkip::RefusedWalks;
       else if (what == "lookups") lookup.skip = ls::LsSkip::Lookups;
-      else return usage();
+      else return usage("--skip takes refused-walks or lookups, not '" + what + "'");
     }
     else if (a == "--exact-width" && i + 1 < argc) options.exact_width = int(count_flag("--exact-width", argv[++i], 4, 8));  // 4 or 8, else InputError
-    else return usage();
+    else return usage("unknown flag, or a flag without its value: '" + a + "'");
   }
   if (lookup.skip != ls::LsSkip::Nothing && (path != Path::Fast || query == Query::AnyHit || query == Query::Lookups)) {
     std::fprintf(stderr, "linespace-profile: --skip times the fast path's closest-hit and occlusion queries only\n");
