@@ -46,7 +46,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 38> cases = {
+  const std::array<std::string, 39> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -71,6 +71,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "build --structure 2l-ls:auto",                       // no --ls-budget
       "build --structure 2l-ls:4:6 --ls-budget 10",          // --ls-budget without 2l-ls:auto
       "build --structure 2l-ls:auto --ls-budget 0.001",      // below the fixed part
+      "build --structure 2l-ls:auto --ls-budget 1e-9",       // under a byte: below the fixed part too, not "no budget"
       "build --structure 2l-ls:auto --ls-budget 10 --ls-budget-rays 0",
       "build --exact-width 16",
       "build --ls-behind sideways",

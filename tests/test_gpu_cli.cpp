@@ -146,7 +146,10 @@ TEST_CASE("linespace-validate candidates and hits report zero mismatches and exi
   REQUIRE(h.status == 0);
   CHECK(h.out.find("3000 compared, 0 mismatches") != std::string::npos);
   for (const char* bad : {"hits --structure octree", "candidates --structure bvh", "candidates --device no-such-device",
-                          "hits --offset 1 2", "hits --rays /nonexistent.rays"}) {
+                          "hits --offset 1 2", "hits --rays /nonexistent.rays",
+                          // nothing to compare: it passed, saying "0 compared"
+                          "candidates --scene builtin:cornell --structure f-ls:2:2 --offset 1e30 0 0",
+                          "candidates --scene builtin:cornell --structure f-ls:30:2"}) {
     const Run r = run(LINESPACE_VALIDATE, bad);
     INFO(bad << "\nstderr: " << r.err);
     CHECK(r.status == 2);

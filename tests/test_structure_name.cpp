@@ -94,6 +94,9 @@ TEST_CASE("structure names: rejections throw InputError", "[structure_name]") {
     INFO("structure text: '" << text << "'");
     CHECK_THROWS_AS(parse_structure(text), InputError);
   }
+  // A number past int says so, as one inside int but outside the range does (it said "not an integer").
+  CHECK_THROWS_WITH(parse_structure("f-ls:4294967297:2"), Catch::Contains("depth D 4294967297 is outside [0, 60]"));
+  CHECK_THROWS_WITH(parse_structure("f-ls:4:99999999999"), Catch::Contains("is outside [1, 64]"));
   // A list is not one structure.
   CHECK_THROWS_AS(parse_structure("bvh,bvh"), InputError);
   CHECK_THROWS_AS(parse_structure("bvh,"), InputError);

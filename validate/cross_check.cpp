@@ -107,6 +107,10 @@ CrossCheckResult cross_check_candidates(const gpu::VulkanContext& context, const
                                         const AccelOptions& options) {
   if (!spec.line_space()) throw InputError("candidates: structure '" + spec.name() + "' has no Line Space (use f-ls:D:N or 2l-ls:D:N)");
   const Accel cpu = build_planned_accel(scene, spec, options);
+  // A check of no shaft would pass saying "0 compared".
+  if (cpu.ls_nodes.empty())
+    throw InputError("candidates: '" + spec.name() + "' has no Line Space node on this scene (none of its subtrees at depth D "
+                     "holds --ls-min-triangles, or --scale/--offset collapsed it): nothing to compare");
   const Accel gpu = gpu::build_accel_gpu(context, scene, spec, options);
   return compare_candidate_arrays(cpu, gpu);
 }

@@ -18,6 +18,9 @@ int parse_int(const std::string& text, const std::string& what, int lo, int hi, 
   int value = 0;
   const char* end = text.data() + text.size();
   auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec == std::errc::result_out_of_range && ptr == end)
+    throw InputError("structure '" + whole + "': " + what + " " + text + " is outside [" + std::to_string(lo) + ", " +
+                     std::to_string(hi) + "]");
   if (text.empty() || ec != std::errc() || ptr != end)
     throw InputError("structure '" + whole + "': " + what + " '" + text + "' is not an integer");
   if (value < lo || value > hi)

@@ -82,7 +82,7 @@ int main(int argc, char** argv) try {
       const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), mb);
       if (error != std::errc() || end != text.data() + text.size() || !(mb > 0.0 && mb <= 1e9))
         throw ls::InputError("--ls-budget must be MB in (0, 1e9], not '" + text + "'");
-      options.plan.budget = size_t(mb * 1e6);
+      options.plan.budget = std::max<size_t>(1, size_t(mb * 1e6));
     }
     else if (a == "--ls-behind" && i + 1 < argc) lookup.behind = ls::parse_ls_behind(argv[++i]);  // else InputError
     else if (a == "--ls-leave-reach" && i + 1 < argc) lookup.leave_reach = ls::parse_ls_leave_reach(argv[++i]);
