@@ -557,7 +557,9 @@ class WideTracer final : public FastTracer {
   // The first turn of a flat structure's ray: true when it parks.
   bool take_off_flat(lsk::TraceContext& c, Flight& f, Query query) const {
     const lsk::Ray& ray = *f.ray;
-    if (start_object(c, f, 0u, ray.origin, ray.dir, LS_INVALID, query != Query::Closest, true) != Begun::Walk) return false;
+    // launch has checked the ray against order_free_ray, and a flat structure's object ray is the ray.
+    if (start_object<true>(c, f, 0u, ray.origin, ray.dir, LS_INVALID, query != Query::Closest, true) != Begun::Walk)
+      return false;
     return fly_object(c, f) == Flown::Parked;
   }
 
@@ -566,11 +568,14 @@ class WideTracer final : public FastTracer {
 
   // f's object walk in the BVH of root `root` for the (object-space) ray origin + t dir, which f.q
   // will refer to: trace_bvh's set-up of an order-free walk.  What needs no walk is traced here: a
-  // root that is a leaf, and a ray outside the order-free walk's arithmetic (the reference kernel).
-  Begun start_object(lsk::TraceContext& c, Flight& f, uint root, const vec3& origin, const vec3& dir, uint instance,
+  // root that is a leaf, and a ray outside the order-free walk's arithmetic (the reference kernel;
+  // kOrderFree: the caller knows the ray is inside it).  Inlined: once a ray, its call cost more
+  // than its body (fireplace, f-ls:8:6 without Line Space nodes: 23 instructions a ray).
+  template <bool kOrderFree = false>
+  LS_ALWAYS_INLINE Begun start_object(lsk::TraceContext& c, Flight& f, uint root, const vec3& origin, const vec3& dir, uint instance,
                      bool any_hit, bool use_ls) const {
     const lsk::Ray& ray = *f.ray;
-    if (!order_free_ray(origin, dir, ray.tmin))
+    if (!kOrderFree && !order_free_ray(origin, dir, ray.tmin))
       return trace_bvh_reference(c, root, origin, dir, ray.tmin, ray.tmax, instance, any_hit, use_ls, f.hit, f.prim)
                  ? Begun::Stopped
                  : Begun::Over;
