@@ -71,7 +71,7 @@ struct Fixture {
     RenderReportContext c = context();
     c.spp = o.spp;
     c.seed = o.seed;
-    return write_shard_outputs(dir.string(), choice, scene, r, c, paper().ls, o.lookup) + ".exr";
+    return write_shard_outputs(dir.string(), choice, scene, r, c, paper().ls, o.lookup, paper().plan) + ".exr";
   }
   std::string write(const ShardChoice& choice, const fs::path& dir) { return write(choice, dir, options); }
 };

@@ -137,3 +137,27 @@ TEST_CASE("bad shard flags and partials of different renders exit 2 with a one-l
   }
   CHECK(!fs::exists(temp("refused")));
 }
+
+// 2l-ls:auto's budget and pilot rays choose each object's D and N: shards planned apart are parts
+// of different images (merged, they once made an image equal to neither render).
+TEST_CASE("partials of 2l-ls:auto renders with another --ls-budget or --ls-budget-rays are refused", "[shards_cli]") {
+  const std::string base = render_args("1", "bvh,2l-ls:auto");
+  render_ok("--shard 0/2 --ls-budget 0.5 --out " + temp("plan_a").string(), base);
+  render_ok("--shard 1/2 --ls-budget 0.5 --out " + temp("plan_a").string(), base);
+  render_ok("--shard 1/2 --ls-budget 2 --out " + temp("plan_budget").string(), base);
+  render_ok("--shard 1/2 --ls-budget 0.5 --ls-budget-rays 2000 --out " + temp("plan_rays").string(), base);
+  const std::string s0 = " " + (temp("plan_a") / "partial-shard-0-of-2.exr").string();
+  const Run same = cpu("merge --out " + temp("plan_merged").string() + s0 + " " +
+                       (temp("plan_a") / "partial-shard-1-of-2.exr").string());
+  INFO(same.err);
+  CHECK(same.status == 0);
+  for (const char* other : {"plan_budget", "plan_rays"}) {
+    const Run r = cpu("merge --out " + temp("plan_refused").string() + s0 + " " +
+                      (temp(other) / "partial-shard-1-of-2.exr").string());
+    INFO(other << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(r.err.find("ls_flags is") != std::string::npos);
+    CHECK(r.err.find(std::string(other) == "plan_budget" ? "ls_budget=2000000" : "ls_budget_rays=2000") != std::string::npos);
+  }
+  CHECK(!fs::exists(temp("plan_refused")));
+}

@@ -43,10 +43,11 @@ std::vector<std::pair<std::string, std::string>> render_identity(const PartialHe
           {"throughput_switch", h.throughput_switch}};
 }
 
-std::string ls_flags_text(const LsBuildOptions& o, const LsLookup& lookup) {
+std::string ls_flags_text(const LsBuildOptions& o, const LsLookup& lookup, const LsPlanOptions& plan) {
   return "angle=" + float_text(lookup.angle_degrees) + " further_rays=" + std::to_string(o.further_rays) +
          " min_triangles=" + std::to_string(o.min_triangles) + " candidates=" + (o.paper_candidates ? "paper" : "compact") +
-         " behind=" + ls_behind_name(lookup.behind) + " leave_reach=" + float_text(lookup.leave_reach);
+         " behind=" + ls_behind_name(lookup.behind) + " leave_reach=" + float_text(lookup.leave_reach) +
+         " ls_budget=" + std::to_string(plan.budget) + " ls_budget_rays=" + std::to_string(plan.rays);
 }
 
 std::string partial_stem(const std::string& selection) {

@@ -41,8 +41,9 @@ struct PartialHeader {
 // What must be equal for partials to belong to one render: (attribute, value) in a fixed order.
 std::vector<std::pair<std::string, std::string>> render_identity(const PartialHeader& header);
 
-// The Line Space flags that change images, as one text ("angle=45 further_rays=0 ...").
-std::string ls_flags_text(const LsBuildOptions& options, const LsLookup& lookup);
+// The Line Space flags that change images, as one text ("angle=45 further_rays=0 ..."): the build's,
+// the lookup's and 2l-ls:auto's plan (its budget and pilot rays choose each object's D and N).
+std::string ls_flags_text(const LsBuildOptions& options, const LsLookup& lookup, const LsPlanOptions& plan);
 
 // "--shard 1/3" -> "partial-shard-1-of-3", "--tiles 0:5" -> "partial-tiles-0-5": the partial's file
 // name without extension, unique per selection so shards can share one folder.

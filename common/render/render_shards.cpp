@@ -29,12 +29,12 @@ ShardChoice choose_tiles(const std::string& tiles, const std::string& shard, uin
 
 std::string write_shard_outputs(const std::string& dir, const ShardChoice& choice, const Scene& scene,
                                 const RenderResult& result, const RenderReportContext& context, const LsBuildOptions& ls,
-                                const LsLookup& lookup) {
+                                const LsLookup& lookup, const LsPlanOptions& plan) {
   PartialHeader h;
   h.scene = context.scene;
   h.scene_fingerprint = fingerprint_text(scene_fingerprint(scene));
   h.schedule = context.schedule;
-  h.ls_flags = ls_flags_text(ls, lookup);
+  h.ls_flags = ls_flags_text(ls, lookup, plan);
   h.throughput_switch = context.throughput_switch.name();
   h.selection = choice.selection;
   h.spp = context.spp;

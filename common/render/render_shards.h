@@ -31,7 +31,7 @@ ShardChoice choose_tiles(const std::string& tiles, const std::string& shard, uin
 // tile_size, tiles and selection), stem = partial_stem(selection); returns DIR/<stem>.
 std::string write_shard_outputs(const std::string& dir, const ShardChoice& choice, const Scene& scene,
                                 const RenderResult& result, const RenderReportContext& context, const LsBuildOptions& ls,
-                                const LsLookup& lookup);
+                                const LsLookup& lookup, const LsPlanOptions& plan);
 
 // `merge`: merges the partials and writes total.exr, bounce_K.exr, image.png (exposed as the shards
 // were asked, from the merged image) and report.json into dir; returns the report.

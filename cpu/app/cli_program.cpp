@@ -224,7 +224,8 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   RenderReportContext ctx{v.scene, options.schedule.name(), v.spp, v.seed, &built, device, nullptr, policy,
                           parse_exposure(v.exposure)};
   if (shard.sharded()) {
-    const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls, options.lookup);
+    const std::string stem = write_shard_outputs(v.out_dir, shard, scene, result, ctx, accel_options.ls, options.lookup,
+                                                 accel_options.plan);
     std::printf("wrote %s.{exr, json} (a partial for merge): %zu of the image's %s\n", stem.c_str(), shard.tiles.size(),
                 shard.grid.describe().c_str());
   } else {
