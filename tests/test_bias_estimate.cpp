@@ -136,3 +136,22 @@ TEST_CASE("rmse_bias: the scale and clamp of the RMSE, no second half, sizes tha
   REQUIRE_FALSE(estimate_bias(ref, img, ref, img, 1.0f, 1, 0).valid());
   REQUIRE_THROWS_AS(estimate_bias(ref, img, ref, {}, 1.0f, 1, 1), InputError);
 }
+
+// Sparse errors at few samples (an 8x8 image at 4 spp): every pixel where the approximation differs,
+// it differs in one half only.  All products are 0; their spread is 0 too, so the estimate was
+// "0 +- 0", and --spp auto stopped there as converged with an RMSE of 0.04.
+TEST_CASE("rmse_bias is undetermined, not 0 +- 0, where the halves differ but never in one pixel", "[bias]") {
+  std::vector<glm::vec3> ref(64, glm::vec3(0.5f)), img_a = ref, img_b = ref;
+  for (size_t i = 0; i < 64; i += 2) img_a[i] = glm::vec3(0.9f);
+  for (size_t i = 1; i < 64; i += 8) img_b[i] = glm::vec3(0.1f);
+  const BiasEstimate e = estimate_bias(ref, img_a, ref, img_b, 1.0f, 2, 2);
+  CHECK_FALSE(e.valid());
+  CHECK(std::isnan(e.rmse_bias_stderr));
+  CHECK(e.noise_floor > 0.0);  // the differences are still measured as noise
+  // One pixel where both halves differ: an estimate again, with an error that is not 0.
+  img_b[0] = glm::vec3(0.9f);
+  const BiasEstimate one = estimate_bias(ref, img_a, ref, img_b, 1.0f, 2, 2);
+  CHECK(one.valid());
+  CHECK(one.rmse_bias > 0.0);
+  CHECK(one.rmse_bias_stderr > 0.0);
+}

@@ -275,8 +275,12 @@ TEST_CASE("the policy study's RMSE and rays on X equal a direct computation from
     const Halves h = render_halves(renderer, o);
     REQUIRE(p.rmse == Approx(rmse(reference_halves.total(), h.total(), e_halves)).epsilon(1e-9));
     REQUIRE(p.rmse > 0.0);
-    REQUIRE(p.bias.rmse_bias == estimate_bias(reference_halves.a.total, h.a.total, reference_halves.b.total, h.b.total,
-                                              e_halves, h.n_a, h.n_b).rmse_bias);
+    const double direct = estimate_bias(reference_halves.a.total, h.a.total, reference_halves.b.total, h.b.total, e_halves,
+                                        h.n_a, h.n_b).rmse_bias;
+    if (std::isnan(direct))  // undetermined on this tiny image (bias_estimate.h): so must the study's be
+      REQUIRE(std::isnan(p.bias.rmse_bias));
+    else
+      REQUIRE(p.bias.rmse_bias == direct);
     REQUIRE(p.indirect_rays == indirect(r, 1));
     if (p.policy == "bounce") {
       REQUIRE(p.rays_on_x == indirect(r, p.start_bounce));  // every ray from the start bounce on

@@ -13,7 +13,10 @@
 namespace ls {
 
 struct BiasEstimate {
-  // sqrt(max(0, mean product)); NaN when there is no second half (1 sample per pixel).
+  // sqrt(max(0, mean product)); NaN when there is no second half (1 sample per pixel), and when the
+  // halves differ from the reference but never in the same pixel: every product is 0, so its spread
+  // says nothing and "0 +- 0" would claim a certainty the samples do not have (a small image at few
+  // spp, where an approximation's errors are sparse).
   double rmse_bias = 0.0;
   // One standard error of rmse_bias: sqrt(max(0, m) + se(m)) - sqrt(max(0, m)) with m the mean product,
   // se(m) = sd / sqrt(pixels) of the per-pixel products (RGB averaged: the pixels are independent, their
