@@ -38,6 +38,7 @@ TEST_CASE("linespace-gpu bad input exits 2 with a one-line reason", "[gpu_cli]")
       "build --structure octree",
       "build --device no-such-device",
       "build --device 99",
+      "build --device ''",  // an unset variable: not "the default device"
       "render --size 0x10 --out " + temp("r").string(),
       "render --schedule bvh,,bvh --size 8x8 --out " + temp("r").string(),
       "trace --rays " + temp("odd.rays").string() + " --hits " + temp("h").string(),

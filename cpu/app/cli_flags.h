@@ -32,6 +32,16 @@ inline CLI::Validator finite_range(double lo, double hi) {
       "FLOAT in " + range);
 }
 
+// After parsing: a flag given an empty value (`--shard "$UNSET"`) is refused.  CLI11 stores the "",
+// which the programs read as the flag not given: `render --shard ''` rendered the whole image.
+inline void refuse_empty_values(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands()) refuse_empty_values(*sub);  // the ones given
+  for (const CLI::Option* o : app.get_options())
+    if (o->count() > 0 && o->get_type_size() != 0)
+      for (const std::string& value : o->results())
+        if (value.empty()) throw CLI::ValidationError(o->get_name(), "an empty value (an unset variable?)");
+}
+
 struct Size {
   uint32_t width = 512, height = 512;
 };

@@ -327,6 +327,7 @@ int run_program(int argc, char** argv, const ProgramInfo& info) {
   const Commands commands = add_commands(app, v, info);
   try {
     app.parse(argc, argv);
+    refuse_empty_values(app);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
