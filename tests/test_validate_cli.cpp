@@ -291,6 +291,24 @@ TEST_CASE("linespace-validate paper prints the three tables and the claims", "[c
   for (const auto& c : j["claims"]) REQUIRE(c["checked"].get<int>() >= c["held"].get<int>());
 }
 
+// Table 2 builds and renders nothing: its rows carry the builds' figures and null for a render's, and
+// the reference is null (they were zeros, which a script would read as exact results).
+TEST_CASE("linespace-validate paper --tables 2 writes no render figures it did not measure", "[cli]") {
+  const fs::path out = temp("paper_t2");
+  const Run r = validate("paper --scenes builtin:cornell --tables 2 --subdivisions 6 --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json study = nlohmann::json::parse(slurp(out / "paper.json"))["scenes"][0]["study"];
+  CHECK(study["reference"].is_null());
+  REQUIRE(!study["rows"].empty());
+  for (const auto& row : study["rows"]) {
+    INFO(row.dump());
+    CHECK(row["bytes_ls"].get<double>() > 0.0);
+    CHECK(row["build_seconds"].get<double>() > 0.0);
+    for (const char* key : {"rmse", "rmse_bias", "spp", "mrays_per_s", "speedup_vs_bvh"}) CHECK(row[key].is_null());
+  }
+}
+
 TEST_CASE("linespace-validate policy writes policy.{md,csv,json} with both policies and the equal-speed comparison", "[cli]") {
   const fs::path out = temp("policy");
   const Run r = validate("policy --scene builtin:cornell --structure f-ls:3:6 --thresholds 0.3,2 --start-bounces 2 --repeat 2 "

@@ -155,7 +155,10 @@ nlohmann::json study_json(const std::string& scene, const std::string& device, c
           {"spp_auto", settings.auto_spp.json()},
           {"bounces", settings.bounces},
           {"seed", settings.seed},
-          {"reference", {{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s}, {"bytes", reference_bytes}}}};
+          // null where no reference was rendered (paper --tables 2 builds only)
+          {"reference", reference_mrays_per_s > 0.0 ? nlohmann::json{{"structure", "bvh"}, {"mrays_per_s", reference_mrays_per_s},
+                                                                     {"bytes", reference_bytes}}
+                                                   : nlohmann::json(nullptr)}};
 }
 
 }  // namespace ls

@@ -111,7 +111,17 @@ nlohmann::json RmseStudy::json() const {
   nlohmann::json rows_json = nlohmann::json::array();
   for (const RmseRow& r : rows) {
     nlohmann::json j{{"structure", r.structure}, {"start_bounce", r.start_bounce}};
-    if (r.refused.empty()) {
+    if (!r.refused.empty()) {
+      j["refused"] = r.refused;
+    } else if (r.spp == 0) {  // built, never rendered (paper --tables 2): no figures of a render, not zeros
+      for (const char* key : {"rmse", "rmse_bias", "rmse_bias_stderr", "noise_floor", "spp", "mrays_per_s",
+                              "exact_mrays_per_s", "speedup_vs_bvh", "contribution_rmse"})
+        j[key] = nullptr;
+      j["bytes"] = r.bytes;
+      j["bytes_ls"] = r.bytes_ls;
+      j["ls_nodes"] = r.ls_nodes;
+      j["build_seconds"] = r.build_seconds;
+    } else {
       j["rmse"] = r.rmse;
       j["rmse_bias"] = number_or_null(r.bias.rmse_bias);
       j["rmse_bias_stderr"] = number_or_null(r.bias.rmse_bias_stderr);
@@ -126,8 +136,6 @@ nlohmann::json RmseStudy::json() const {
       j["ls_nodes"] = r.ls_nodes;
       j["build_seconds"] = r.build_seconds;
       j["contribution_rmse"] = r.contribution_rmse;
-    } else {
-      j["refused"] = r.refused;
     }
     rows_json.push_back(j);
   }
