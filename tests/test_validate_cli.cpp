@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <fstream>
 
 using namespace test_support;
 namespace fs = std::filesystem;
@@ -289,6 +291,21 @@ TEST_CASE("linespace-validate paper prints the three tables and the claims", "[c
   REQUIRE(t4[0]["rmse"] == 0.0);  // the all-exact schedule against itself
   REQUIRE(j["claims"].size() >= 6);
   for (const auto& c : j["claims"]) REQUIRE(c["checked"].get<int>() >= c["held"].get<int>());
+}
+
+// A study checks its --out before any work: it once ran to its end and failed there on a file.
+TEST_CASE("linespace-validate studies refuse an --out that is a file before any work", "[cli]") {
+  const fs::path file = temp("a_file");
+  fs::create_directories(file.parent_path());
+  std::ofstream(file) << "not a folder\n";
+  for (const char* study : {"rmse", "sweep", "paper", "budget", "policy", "bound"}) {
+    const auto start = std::chrono::steady_clock::now();
+    const Run r = validate(std::string(study) + " --out " + file.string());
+    INFO(study << "\nstderr: " << r.err);
+    CHECK(r.status == 2);
+    CHECK(r.err.find("is a file, not a folder") != std::string::npos);
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(5));
+  }
 }
 
 // Table 2 builds and renders nothing: its rows carry the builds' figures and null for a render's, and

@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <set>
 #include <iostream>
 
@@ -289,6 +290,10 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < check_offset.size() && i < 3; ++i) check.offset[i] = check_offset[i];
     if (*candidates_cmd) return validate::run_candidates_command(check, ls_flags.options());
     if (*hits_cmd) return validate::run_hits_command(check, ls_flags.options(), ls_flags.lookup());
+    // Before any work: a study that has run for hours must not fail at its end on its --out.
+    std::error_code ec;
+    if (!out_dir.empty() && std::filesystem::exists(out_dir, ec) && !std::filesystem::is_directory(out_dir, ec))
+      throw InputError("--out '" + out_dir + "' is a file, not a folder");
     if (*rmse_cmd) {
       const std::vector<StructureSpec> specs = parse_structure_list(structures);
       const ImageSettings settings = image_settings();
