@@ -439,6 +439,22 @@ TEST_CASE("bench and linespace-profile --embree refuse rays Embree cannot take; 
   CHECK(nlohmann::json::parse(ls.out)["embree_disagreement"].is_null());
 }
 
+// A schedule's entries past --bounces trace nothing: they are not built, so no budget refuses them
+// (f-ls:8:10 takes more than 50 MB on cornell; bounce 0 traces with bvh alone).
+TEST_CASE("render builds only what bounces 0..B trace", "[cli]") {
+  const fs::path out = temp("render_b0");
+  const Run r = run("render --scene builtin:cornell --bounces 0 --schedule bvh,f-ls:8:10 --max-memory 50 --size 8x8 --spp 1 "
+                    "--quiet --out " + out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto report = nlohmann::json::parse(slurp(out / "report.json"));
+  REQUIRE(report["structures"].size() == 1);
+  CHECK(report["structures"][0]["structure"] == "bvh");
+  const Run used = run("render --scene builtin:cornell --bounces 1 --schedule bvh,f-ls:8:10 --max-memory 50 --size 8x8 "
+                       "--spp 1 --quiet --out " + out.string());
+  CHECK(used.status == 2);  // the same entry, traced from bounce 1, is over the budget: the check can fail
+}
+
 TEST_CASE("an output path that is a directory exits 2 naming it, and leaves no temporary file", "[cli]") {
   const fs::path dir = temp("outputs");
   fs::remove_all(dir);
@@ -594,18 +610,20 @@ TEST_CASE("render --frames writes one folder per frame and frames.json with the 
   write_text(temp("slide.gltf"), animated_gltf());
   const fs::path out = temp("frames");
   fs::remove_all(out);
-  const Run r = run("render --scene " + temp("slide.gltf").string() + " --schedule bvh,2l-bvh,2l-ls:1:2 --spp 1 --bounces 1 " +
+  // --bounces 2: every entry of the schedule is traced (one past the last bounce would not be built).
+  const Run r = run("render --scene " + temp("slide.gltf").string() + " --schedule bvh,2l-bvh,2l-ls:1:2 --spp 1 --bounces 2 " +
                     "--size 24x16 --frames 2:4 --fps 4 --out " + out.string());
   INFO(r.out << r.err);
   REQUIRE(r.status == 0);
   std::vector<std::string> pngs;
   for (int f = 2; f <= 4; ++f) {
     const fs::path dir = out / ("frame_000" + std::to_string(f));
-    for (const char* file : {"total.exr", "bounce_0.exr", "bounce_1.exr", "image.png", "report.json"}) CHECK(fs::exists(dir / file));
+    for (const char* file : {"total.exr", "bounce_0.exr", "bounce_1.exr", "bounce_2.exr", "image.png", "report.json"})
+      CHECK(fs::exists(dir / file));
     std::ifstream rf(dir / "report.json");
     const json report = json::parse(rf);
     CHECK(report["frame"]["frame"] == f);
-    CHECK(report["per_bounce"].size() == 2);
+    CHECK(report["per_bounce"].size() == 3);
     pngs.push_back(slurp(dir / "image.png"));
   }
   CHECK(pngs[0] != pngs[1]);  // the triangle moved

@@ -212,12 +212,11 @@ void run_render(const Scene& scene, const Values& v, Backend& backend) {
   check_render_budget(options.width, options.height, options.bounces, accel_options.limits.max_memory);
   const ShardChoice shard = choose_tiles(v.tiles, v.shard, v.tile_size, options.width, options.height);
   if (shard.sharded()) options.pixels = tile_pixels(shard.grid, shard.tiles);  // a shard: only its tiles
+  // What bounces 0..B trace, the switch's structure included: a schedule's entries past --bounces are
+  // not built (they were, and could be refused by the memory budget for a render that never used them).
   std::map<std::string, Accel> built;
-  for (const StructureSpec& spec : options.schedule.per_bounce)
-    if (!built.count(spec.name())) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
+  for (const StructureSpec& spec : render_structures(options)) built.emplace(spec.name(), backend.build(scene, spec, accel_options));
   const ThroughputSwitch& policy = options.throughput_switch;
-  if (policy.enabled() && !built.count(policy.structure.name()))
-    built.emplace(policy.structure.name(), backend.build(scene, policy.structure, accel_options));
   const Progress progress = progress_bar(v);
   const RenderResult result = backend.render(scene, built, options, progress);
   const std::string device = backend.device();

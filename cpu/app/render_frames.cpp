@@ -147,12 +147,9 @@ void render_frames(Scene scene, const std::string& scene_spec, const RenderOptio
       std::fprintf(stderr, "note: frames after t = %g s (the animation's end) hold its last pose\n", duration);
   }
 
-  // The schedule's distinct structures, in schedule order; the two-level ones built once, here.
-  std::vector<StructureSpec> distinct;
-  std::vector<StructureSpec> used = options.schedule.per_bounce;
-  if (options.throughput_switch.enabled()) used.push_back(options.throughput_switch.structure);  // --throughput-switch's too
-  for (const StructureSpec& spec : used)
-    if (std::find(distinct.begin(), distinct.end(), spec) == distinct.end()) distinct.push_back(spec);
+  // The distinct structures bounces 0..B trace (--throughput-switch's too), in schedule order; the
+  // two-level ones built once, here.
+  const std::vector<StructureSpec> distinct = render_structures(options);
   std::map<std::string, Accel> built;
   json initial = json::array();
   for (const StructureSpec& spec : distinct)
