@@ -234,6 +234,12 @@ TEST_CASE("list flags of the validator reject nonsense", "[validate]") {
   REQUIRE_THROWS_AS(parse_behind_list("exact,ahead"), InputError);
   REQUIRE(parse_min_triangles_list("0,512") == std::vector<uint32_t>{0, 512});
   REQUIRE_THROWS_AS(parse_min_triangles_list("-1"), InputError);
+  // Repeats are dropped, each item at its first place (they rendered the same configuration twice).
+  REQUIRE(parse_int_list("8,2,8,2,4", "--depths", 0, 60) == std::vector<int>{8, 2, 4});
+  REQUIRE(parse_angle_list("30,45,30") == std::vector<float>{30.0f, 45.0f});
+  REQUIRE(parse_families("2l-ls,f-ls,2l-ls") == std::vector<StructureKind>{StructureKind::TwoLevelLs, StructureKind::FlatLs});
+  REQUIRE(parse_behind_list("exact,exact") == std::vector<LsBehind>{LsBehind::Exact});
+  REQUIRE(parse_min_triangles_list("512,0,512") == std::vector<uint32_t>{512, 0});
 }
 
 TEST_CASE("interpolation on the policy curves: linear between neighbours, none outside", "[validate]") {

@@ -137,7 +137,7 @@ std::vector<std::string> scene_list(const std::string& text) {
     const size_t comma = text.find(',', start);
     const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     if (item.empty()) throw InputError("--scenes '" + text + "': empty scene name");
-    out.push_back(item);
+    if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);  // repeats: once
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -295,7 +295,7 @@ int main(int argc, char** argv) {
     if (!out_dir.empty() && std::filesystem::exists(out_dir, ec) && !std::filesystem::is_directory(out_dir, ec))
       throw InputError("--out '" + out_dir + "' is a file, not a folder");
     if (*rmse_cmd) {
-      const std::vector<StructureSpec> specs = parse_structure_list(structures);
+      const std::vector<StructureSpec> specs = without_repeats(parse_structure_list(structures));
       const ImageSettings settings = image_settings();
       const Scene scene = load_scene(scene_spec);
       auto renderer = make_study_renderer(device, scene, ls_flags.options());

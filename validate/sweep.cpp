@@ -37,7 +37,7 @@ std::vector<int> parse_int_list(const std::string& text, const std::string& flag
                        std::to_string(hi) + "]");
     out.push_back(int(v));
   }
-  return out;
+  return without_repeats(out);
 }
 
 std::vector<float> parse_angle_list(const std::string& text) {
@@ -54,7 +54,7 @@ std::vector<float> parse_angle_list(const std::string& text) {
       throw InputError("--angles " + text + ": '" + item + "' is not an angle in [0, 90] degrees");
     out.push_back(float(v));
   }
-  return out;
+  return without_repeats(out);
 }
 
 std::vector<LsBehind> parse_behind_list(const std::string& text) {
@@ -66,7 +66,7 @@ std::vector<LsBehind> parse_behind_list(const std::string& text) {
       throw InputError("--behinds " + text + ": '" + item + "' is not a mode (exact, empty or reverse)");
     }
   }
-  return out;
+  return without_repeats(out);
 }
 
 std::vector<uint32_t> parse_min_triangles_list(const std::string& text) {
@@ -82,7 +82,7 @@ std::vector<StructureKind> parse_families(const std::string& text) {
     else if (item == "2l-ls") out.push_back(StructureKind::TwoLevelLs);
     else throw InputError("--families " + text + ": '" + item + "' is neither f-ls nor 2l-ls");
   }
-  return out;
+  return without_repeats(out);
 }
 
 namespace {

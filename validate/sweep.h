@@ -11,6 +11,8 @@
 #include "validate/table.h"
 
 #include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,16 @@ struct Sweep {
   Table table() const;
   nlohmann::json json() const;
 };
+
+// The lists of the studies' flags keep an item's first place and drop its repeats ("--depths 2,2"
+// rendered the same configuration twice), as --thresholds does.
+template <class T>
+std::vector<T> without_repeats(const std::vector<T>& items) {
+  std::vector<T> out;
+  for (const T& item : items)
+    if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
+  return out;
+}
 
 std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int lo, int hi);
 std::vector<float> parse_angle_list(const std::string& text);
