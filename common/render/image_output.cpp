@@ -93,7 +93,9 @@ bool is_png(const std::string& path) {
 
 // Every channel of an EXR as floats, interleaved in the file's channel order (sorted by name).
 ChannelImage read_float_exr(const std::string& path, const std::string& attribute_prefix, const std::string& what) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError("cannot read " + what + "'" + path + "': no such file");
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError("cannot read " + what + "'" + path + "': it is a directory");
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("cannot read " + what + "'" + path + "': no such file");
   try {
     Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();

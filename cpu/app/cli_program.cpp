@@ -118,7 +118,7 @@ Commands add_commands(CLI::App& app, Values& v, const ProgramInfo& info) {
       "--frames", v.frames, "render frames A..B of the scene's animation (A:B or N) into OUT/frame_NNNN/ and OUT/frames.json");
   c.render->add_option("--fps", v.fps, "frames per second: frame f is posed at t = f / fps")->capture_default_str()->needs(frames);
   c.render->add_option("--animation", v.animation, "which of the scene's animations --frames renders (index)")
-      ->capture_default_str()->needs(frames);
+      ->capture_default_str()->needs(frames)->check(CLI::Range(0, 1 << 20));  // -1 was read as 2^64 - 1
   c.render->add_flag("--no-flat-comparison", v.no_flat_comparison, "do not time a flat rebuild beside each 2L update")->needs(frames);
   c.render->add_option("--top-level-update", v.top_level, "how 2L structures follow the animation: rebuild or refit their top level")
       ->capture_default_str()->check(CLI::IsMember({"rebuild", "refit"}))->needs(frames);
