@@ -5,13 +5,8 @@
 # --ls-min-triangles is obeyed: above every subtree's size no Line Space node is left, so f-ls hits
 # exactly what bvh hits.
 #   tests/profile/check_counts.sh BUILD_DIR
-set -euo pipefail
-build=$1
-cpu=$build/cpu/linespace-cpu
-profile=$build/cpu/linespace-profile
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+# shellcheck source=tests/profile/setup.sh
+source "$(dirname "$0")/setup.sh"
 
 "$cpu" rays --scene builtin:cornell --kind diffuse --count 2000 --seed 3 --out "$tmp/rays" > /dev/null 2>&1
 for flags in "--repeat 0" "--repeat 3x" "--repeat x" "--ls-min-triangles -1" "--ls-min-triangles abc" \

@@ -3,13 +3,8 @@
 # their number and answers must be what `linespace-cpu trace --traversal reference` counts on the same
 # rays; a structure without a Line Space, or a two-level one, is refused with exit 2.
 #   tests/profile/check_lookups.sh BUILD_DIR
-set -euo pipefail
-build=$1
-cpu=$build/cpu/linespace-cpu
-profile=$build/cpu/linespace-profile
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+# shellcheck source=tests/profile/setup.sh
+source "$(dirname "$0")/setup.sh"
 
 for scene in builtin:cornell builtin:generated:3000:4:2; do
   "$cpu" rays --scene "$scene" --kind diffuse --count 3000 --seed 3 --out "$tmp/rays" > /dev/null 2>&1

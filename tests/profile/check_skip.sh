@@ -5,13 +5,8 @@
 # reference, Embree, any hit, --lookups), a structure without Line Space nodes and an unknown value
 # are refused with exit 2.
 #   tests/profile/check_skip.sh BUILD_DIR
-set -euo pipefail
-build=$1
-cpu=$build/cpu/linespace-cpu
-profile=$build/cpu/linespace-profile
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+# shellcheck source=tests/profile/setup.sh
+source "$(dirname "$0")/setup.sh"
 
 "$cpu" rays --scene builtin:cornell --kind diffuse --count 2000 --seed 3 --out "$tmp/rays" > /dev/null 2>&1
 hits() { sed -n 's/.*, \([0-9]*\) of 2000 rays hit$/\1/p'; }
