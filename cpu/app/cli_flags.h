@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 
@@ -157,7 +158,8 @@ struct LsFlags {
     o.ls.min_triangles = min_triangles;
     o.ls.paper_candidates = candidates == "paper";
     o.limits.max_memory = size_t(max_memory_mb * 1e6);
-    o.plan.budget = ls_budget_mb > 0.0 ? std::max<size_t>(1, size_t(ls_budget_mb * 1e6)) : 0;  // under a byte: "below the fixed part", not "no budget"
+    // Under a byte is a budget below the fixed part, not "no budget".
+    o.plan.budget = ls_budget_mb > 0.0 ? std::max<size_t>(1, size_t(ls_budget_mb * 1e6)) : 0;
     o.plan.rays = ls_budget_rays;
     o.plan.lookup = lookup();  // 2l-ls:auto measures its plan with the lookup the renders use
     o.traversal = parse_traversal(traversal);

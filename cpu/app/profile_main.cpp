@@ -19,8 +19,10 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <functional>
@@ -92,7 +94,8 @@ int main(int argc, char** argv) try {
       else if (what == "lookups") lookup.skip = ls::LsSkip::Lookups;
       else return usage("--skip takes refused-walks or lookups, not '" + what + "'");
     }
-    else if (a == "--exact-width" && i + 1 < argc) options.exact_width = int(count_flag("--exact-width", argv[++i], 4, 8));  // 4 or 8, else InputError
+    else if (a == "--exact-width" && i + 1 < argc)
+      options.exact_width = int(count_flag("--exact-width", argv[++i], 4, 8));  // 5 to 7: InputError when built
     else return usage("unknown flag, or a flag without its value: '" + a + "'");
   }
   if (lookup.skip != ls::LsSkip::Nothing && (path != Path::Fast || query == Query::AnyHit || query == Query::Lookups)) {
