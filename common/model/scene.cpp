@@ -95,8 +95,7 @@ Camera framing_camera(const Scene& scene) {
   cam.target = glm::vec3(centre);
   cam.position = glm::vec3(centre + glm::dvec3(0.0, 0.0, dist > 0.0 ? dist : 1.0));
   cam.up = glm::vec3(0.0f, 1.0f, 0.0f);
-  if (!std::isfinite(cam.position.z) || cam.position == cam.target)
-  {
+  if (!std::isfinite(cam.position.z) || cam.position == cam.target) {
     char text[160];
     std::snprintf(text, sizeof text, "a camera framing this scene (%g in radius) cannot be placed in float", radius);
     throw InputError(std::string(text) + ": the scene needs a camera of its own (glTF) or a smaller scale");
