@@ -11,15 +11,19 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${LINESPACE_CPU:-build/release/cpu/linespace-cpu}
 RUNS=${RUNS:-3}
-[[ -x $BIN ]] || { echo "bench-build: $BIN is not built (scripts/run-demo.sh builds it)" >&2; exit 2; }
-[[ -z ${COMPARE:-} || -x $COMPARE ]] || { echo "bench-build: COMPARE=$COMPARE is not an executable" >&2; exit 2; }
+fail() { echo "bench-build: $*" >&2; exit 2; }
+[[ -x $BIN ]] || fail "$BIN is not built (scripts/run-demo.sh builds it)"
+[[ $RUNS =~ ^[1-9][0-9]*$ ]] || fail "RUNS=$RUNS is not a positive integer"
+[[ -z ${COMPARE:-} || -x $COMPARE ]] || fail "COMPARE=$COMPARE is not an executable"
+tmp=$(mktemp)
+trap 'rm -f "$tmp"' EXIT  # also when a run fails
 scenes=("$@")
 if [[ ${#scenes[@]} -eq 0 ]]; then
   scenes=(builtin:cornell builtin:generated:143000:49:1 builtin:instances)
   for f in assets/real/*.glb; do [[ -e $f ]] && scenes+=("$f"); done
 fi
 
-median() { sort -g | awk '{v[NR] = $1} END {print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+median() { sort -g | awk '{v[NR] = $1} END {if (NR) print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }  # nothing of nothing
 # bench's last column is the build milliseconds of each structure and of Embree.
 times() { "$1" bench --scene "$2" --count 1000 --repeat 1 --structures bvh,2l-bvh | awk '$1 == "bvh" || $1 == "2l-bvh" || $1 == "embree" {print $1, $NF}'; }
 
@@ -29,7 +33,7 @@ rule="|---|---|---|---|---|"
 echo "$header"
 echo "$rule"
 for scene in "${scenes[@]}"; do
-  tmp=$(mktemp)
+  : > "$tmp"
   for ((run = 1; run <= RUNS; ++run)); do
     echo "  $scene: run $run of $RUNS" >&2
     times "$BIN" "$scene" | sed 's/^/new /' >> "$tmp"
@@ -37,11 +41,12 @@ for scene in "${scenes[@]}"; do
   done
   pick() { awk -v w="$1" -v s="$2" '$1 == w && $2 == s {print $3}' "$tmp" | median; }
   bvh=$(pick new bvh); emb=$(pick new embree); two=$(pick new 2l-bvh)
+  [[ -n $bvh && -n $emb && -n $two ]] || fail "$BIN printed no build times for $scene"
   line="| $scene | $bvh | $emb | $(awk -v a="$bvh" -v b="$emb" 'BEGIN {printf "%.2f", a / b}')x | $two |"
   if [[ -n ${COMPARE:-} ]]; then
     obvh=$(pick old bvh); oemb=$(pick old embree)
+    [[ -n $obvh && -n $oemb ]] || fail "COMPARE=$COMPARE printed no build times for $scene (not a linespace-cpu?)"
     line+=" $obvh | $oemb | $(awk -v a="$obvh" -v b="$oemb" 'BEGIN {printf "%.2f", a / b}')x |"
   fi
   echo "$line"
-  rm -f "$tmp"
 done

@@ -45,17 +45,21 @@ bench() {
     --embree-isa "$EMBREE_ISA" --threads "$THREADS" $LS_FLAGS --json
   echo
 }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT  # also when a run fails
+tmp=$work/runs
+old=$work/compare_runs
 for scene in "${scenes[@]}"; do
-  tmp=$(mktemp)
-  old=$(mktemp)
+  : > "$tmp"
+  : > "$old"
   for ((run = 1; run <= RUNS; ++run)); do
     echo "  $scene: run $run of $RUNS" >&2
     bench "$BIN" "$scene" >> "$tmp"
     if [[ -n ${COMPARE:-} ]]; then bench "$COMPARE" "$scene" >> "$old"; fi
   done
-  python3 - "$scene" "$tmp" "$old" <<'EOF'
+  python3 - "$scene" "$tmp" "$old" "${COMPARE:-}" <<'EOF'
 import json, statistics, sys
-scene, path, compare_path = sys.argv[1:4]
+scene, path, compare_path, compare_program = sys.argv[1:5]
 def read(path):
     runs, text = [], open(path).read()
     decoder, at = json.JSONDecoder(), 0
@@ -71,6 +75,8 @@ def medians(runs, name):  # MRays/s, ratio to Embree, fast / reference
     return (statistics.median(e["mrays_per_s"] for e in entries), statistics.median(e["ratio_vs_embree"] for e in entries),
             statistics.median(e["mrays_per_s"] / e["reference_mrays_per_s"] for e in entries))
 runs, compare = read(path), read(compare_path)
+if compare_program and not compare:
+    sys.exit(f"bench-traversal: COMPARE={compare_program} printed no bench results for {scene} (not a linespace-cpu?)")
 embree = statistics.median(next(e["mrays_per_s"] for e in r["results"] if e["structure"] == "embree") for r in runs)
 isa = runs[0]["embree_isa"]
 for name in [e["structure"] for e in runs[0]["results"] if e["structure"] != "embree"]:
@@ -81,5 +87,4 @@ for name in [e["structure"] for e in runs[0]["results"] if e["structure"] != "em
         line += f" {old_fast:.2f} | {old_ratio:.2f}x |"
     print(line)
 EOF
-  rm -f "$tmp" "$old"
 done

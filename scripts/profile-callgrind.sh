@@ -35,7 +35,16 @@ if [[ ${#scenes[@]} -eq 0 ]]; then
 fi
 IFS=, read -r -a structures <<< "$STRUCTURES"
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# On any exit, the callgrind runs still going end too (a failure left them running, orphaned).
+cleanup() {
+  local running
+  running=$(jobs -pr)
+  # shellcheck disable=SC2086  # a list of pids
+  [[ -z $running ]] || kill $running 2> /dev/null || true
+  wait 2> /dev/null || true
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
 
 # One job a line: label <TAB> toggle <TAB> linespace-profile arguments after the ray file.
 queries() {
@@ -60,16 +69,24 @@ for si in "${!scenes[@]}"; do
     > /dev/null 2> "$tmp/rays.err" || fail "could not make rays for $scene: $(cat "$tmp/rays.err")"
   qi=0
   while IFS=$'\t' read -r label toggle args; do
-    while (( $(jobs -rp | wc -l) >= JOBS )); do wait -n; done
+    # A job's status is in its .status file: wait -n's would end the script under set -e, silently.
+    while (( $(jobs -rp | wc -l) >= JOBS )); do wait -n || true; done
     read -r structure flags <<< "$args"
-    # shellcheck disable=SC2086  # flags is a list of flags
-    valgrind --tool=callgrind --callgrind-out-file=/dev/null "--toggle-collect=$toggle" \
-      "$BUILD/cpu/linespace-profile" "$scene" "$structure" "$rays" $flags > /dev/null 2> "$tmp/$si.$qi.log" &
+    (
+      status=0
+      # shellcheck disable=SC2086  # flags is a list of flags
+      valgrind --tool=callgrind --callgrind-out-file=/dev/null "--toggle-collect=$toggle" \
+        "$BUILD/cpu/linespace-profile" "$scene" "$structure" "$rays" $flags > /dev/null 2> "$tmp/$si.$qi.log" || status=$?
+      echo "$status" > "$tmp/$si.$qi.status"
+    ) &
     echo "$label" > "$tmp/$si.$qi.label"
     qi=$((qi + 1))
   done < <(queries)
   wait
   for ((q = 0; q < qi; ++q)); do
+    # The program's own reason: the first line of its stderr without valgrind's (==PID==).
+    [[ $(cat "$tmp/$si.$q.status") == 0 ]] ||
+      fail "$scene, $(cat "$tmp/$si.$q.label"): $(grep -v '^==' "$tmp/$si.$q.log" | head -n 1)"
     refs=$(sed -n 's/.*I *refs: *\([0-9,]*\).*/\1/p' "$tmp/$si.$q.log" | tr -d ,)
     [[ -n $refs ]] || fail "callgrind gave no count for $scene, $(cat "$tmp/$si.$q.label"): $(tail -n 3 "$tmp/$si.$q.log")"
     # Zero: the toggle matched no function (renamed?), which must not pass for a measurement.
