@@ -308,6 +308,17 @@ TEST_CASE("linespace-validate studies refuse an --out that is a file before any 
   }
 }
 
+// Every point refused (over --max-memory): the sweep says so, where the plot step once took the blame.
+TEST_CASE("linespace-validate sweep whose every configuration is refused says so and exits 2", "[cli]") {
+  const Run r = validate("sweep --scene builtin:cornell --families f-ls --depths 8 --subdivisions 10 --size 8x8 --spp 2 "
+                         "--bounces 1 --timing-rounds 1 --max-memory 20 --out " + temp("all_refused").string());
+  INFO(r.err);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("every configuration was refused (f-ls:8:10: structure 'f-ls:8:10' would take up to") != std::string::npos);
+  CHECK(r.err.find("matplotlib") == std::string::npos);
+  CHECK(fs::exists(temp("all_refused") / "sweep.json"));  // the refusals are data too
+}
+
 // Table 2 builds and renders nothing: its rows carry the builds' figures and null for a render's, and
 // the reference is null (they were zeros, which a script would read as exact results).
 TEST_CASE("linespace-validate paper --tables 2 writes no render figures it did not measure", "[cli]") {

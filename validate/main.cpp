@@ -21,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -332,6 +333,11 @@ int main(int argc, char** argv) {
       const Sweep sweep = run_sweep(*renderer, scene_spec, grid, settings, log_line);
       write_sweep(out_dir, sweep);
       std::printf("%s\nwrote %s/{sweep.csv, sweep.json, sweep.md}\n", sweep.table().markdown().c_str(), out_dir.c_str());
+      // Nothing to plot, and nothing learnt: say why here (the plot step once took the blame).
+      const auto measured = std::find_if(sweep.points.begin(), sweep.points.end(), [](const SweepPoint& p) { return p.refused.empty(); });
+      if (measured == sweep.points.end() && !sweep.points.empty())
+        throw InputError("sweep: every configuration was refused (" + sweep.points.front().structure + ": " +
+                         sweep.points.front().refused + ")");
       if (!no_plot) {
         plot_sweep(out_dir);
         std::printf("wrote %s/{tradeoff.png, tradeoff.svg}\n", out_dir.c_str());
