@@ -12,10 +12,12 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -248,7 +250,18 @@ TEST_CASE("trace --against counts the rays whose hit differs from another hit fi
   // A hit file of other rays, or none: exit 2 with one line naming the file.
   std::vector<lsk::Hit> fewer(a.begin(), a.end() - 1);
   ls::write_hits(short_file, fewer);
-  for (const std::string& bad : {short_file, temp("no-such.hits").string()}) {
+  // The right count of records that are no hits of this scene: an instance past its 10, a NaN t, a
+  // miss that names a triangle (random bytes were once compared as hits).
+  std::vector<std::string> not_hits;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<lsk::Hit> h = a;
+    if (k == 0) h[5].instance = 10;
+    if (k == 1) h[5].t = std::nanf("");
+    if (k == 2) h[5] = lsk::Hit{std::numeric_limits<float>::infinity(), lsk::LS_INVALID, 7u, 0.0f, 0.0f};
+    not_hits.push_back(temp("not_hits_" + std::to_string(k) + ".hits").string());
+    ls::write_hits(not_hits.back(), h);
+  }
+  for (const std::string& bad : {short_file, temp("no-such.hits").string(), not_hits[0], not_hits[1], not_hits[2]}) {
     const Run r = run("trace --scene builtin:cornell --structure bvh --rays " + rays + " --hits " + approx + " --against " + bad);
     CHECK(r.status == 2);
     CHECK(line_count(r.err) == 1);

@@ -21,11 +21,30 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 
 namespace ls {
 namespace {
+
+// A hit file of this scene's hits (design.md §9): a miss is t = +inf with both ids 0xFFFFFFFF, a
+// hit a finite t and a triangle of one of its instances.  Random bytes of the right size were once
+// compared as hits ("100 % hit another triangle").
+void check_hits_of_scene(const std::vector<lsk::Hit>& hits, const Scene& scene, const std::string& what) {
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const lsk::Hit& h = hits[i];
+    const bool miss = h.t == std::numeric_limits<float>::infinity();
+    const bool ok = miss ? h.instance == lsk::LS_INVALID && h.triangle == lsk::LS_INVALID
+                         : std::isfinite(h.t) && h.instance < scene.instances.size() &&
+                               h.triangle < scene.meshes[scene.instances[h.instance].mesh].triangles.size();
+    if (!ok)
+      throw InputError(what + ", hit " + std::to_string(i) + ": t " + std::to_string(h.t) + ", instance " +
+                       std::to_string(h.instance) + ", triangle " + std::to_string(h.triangle) +
+                       " is neither a miss nor a triangle of this scene");
+  }
+}
 
 // Every option of every subcommand, with its default.
 struct Values {
@@ -295,6 +314,7 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
     if (!v.against_path.empty() && against.size() != in.size())
       throw InputError("--against " + v.against_path + " holds " + std::to_string(against.size()) + " hits for " +
                        std::to_string(in.size()) + " rays: it must be a hit file of the same ray file");
+    if (!v.against_path.empty()) check_hits_of_scene(against, scene, "--against " + v.against_path);
     const Accel accel = backend->build(scene, parse_structure(v.structure), v.ls.options());
     lsk::LsCounters counters{};
     std::string timing;
