@@ -48,7 +48,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
   write_text(temp("nan.obj"), "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   write_text(temp("empty.obj"), "");
   write_text(temp("odd.rays"), std::string(33, '\0'));
-  const std::array<std::string, 45> cases = {
+  const std::array<std::string, 46> cases = {
       "build --scene /nonexistent/scene.gltf",
       "build --scene " + temp("bad.gltf").string(),
       "build --scene " + temp("nan.obj").string(),
@@ -96,6 +96,7 @@ TEST_CASE("bad input exits 2 with a one-line reason", "[cli]") {
       "render --throughput-switch '' --size 8x8 --out " + temp("r").string(),
       "rays --seed '' --count 10 --out " + temp("x.rays").string(),
       "render --frames 0:1 --animation -1 --size 8x8 --out " + temp("r").string(),  // once read as 2^64 - 1
+      "rays --kind shadow --count 1 --out " + temp("x.rays").string(),  // one origin: no segment (zero length once)
   };
   for (const std::string& args : cases) {
     const Run r = run(args);

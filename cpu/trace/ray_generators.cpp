@@ -34,11 +34,16 @@ lsk::Ray primary_ray(const lsk::CameraFrame& cam, uint32_t seed, uint32_t index)
 std::vector<lsk::Ray> generate_rays(const Scene& scene, const Accel& exact, RayKind kind, size_t count, uint32_t seed) {
   if (kind == RayKind::Shadow) {
     // Segments between the origins of two diffuse rays (surface points, each offset off its surface).
+    if (count < 2) throw InputError("shadow rays join the origins of two diffuse rays: --count must be at least 2");
     std::vector<lsk::Ray> rays = generate_rays(scene, exact, RayKind::Diffuse, count, seed);
     std::vector<lsk::Ray> segments(count);
     for (size_t i = 0; i < count; ++i) {
       size_t j = (i + count / 2) % count;
       if (rays[j].origin == rays[i].origin) j = (i + 1) % count;
+      // Past that, the next origin that is another point (a zero-length segment is no ray).
+      for (size_t tries = 0; rays[j].origin == rays[i].origin && tries < count; ++tries) j = (j + 1) % count;
+      if (rays[j].origin == rays[i].origin)
+        throw InputError("shadow rays: every diffuse ray of this scene starts at one point, no segment joins two");
       segments[i].origin = rays[i].origin;
       segments[i].tmin = 0.0f;
       segments[i].dir = rays[j].origin - rays[i].origin;
