@@ -76,4 +76,17 @@ def main(paths):
 if __name__ == "__main__":
     if len(sys.argv) < 2:
         sys.exit(__doc__)
-    main(sys.argv[1:])
+    try:
+        main(sys.argv[1:])
+    except FileNotFoundError as e:
+        if e.filename == "oiiotool":
+            print("image-stats.py: needs oiiotool: apt-get install openimageio-tools", file=sys.stderr)
+        else:
+            print(f"image-stats.py: {e}", file=sys.stderr)
+        sys.exit(2)
+    except subprocess.CalledProcessError as e:
+        print(f"image-stats.py: oiiotool could not read {e.cmd[-1]}: {(e.stderr or '').strip().splitlines()[:1]}", file=sys.stderr)
+        sys.exit(2)
+    except ValueError as e:  # an image of no pixels
+        print(f"image-stats.py: {e}", file=sys.stderr)
+        sys.exit(2)

@@ -122,8 +122,8 @@ void plot_sweep(const std::string& dir) {
   const std::string cmd = "/usr/bin/python3 '" LINESPACE_PLOT_SCRIPT "' '" + dir + "'";
   const int status = std::system(cmd.c_str());
   if (status != 0)
-    throw InputError("the plot step failed (" + cmd + "); it needs Debian's python3-matplotlib, which scripts/setup.sh "
-                     "installs. The data is in " + dir + "/sweep.{csv,json}");
+    throw InputError("the plot step failed (" + cmd + ": its reason is above; it needs Debian's python3-matplotlib, which "
+                     "scripts/setup.sh installs). The data is in " + dir + "/sweep.{csv,json}");
 }
 
 std::set<int> int_set(const std::string& text, const std::string& flag, int lo, int hi) {

@@ -8,7 +8,11 @@ Run with Debian's python3 (package python3-matplotlib)."""
 import json
 import sys
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError:
+    print("plot_tradeoff.py: needs Debian's python3-matplotlib (scripts/setup.sh installs it)", file=sys.stderr)
+    sys.exit(2)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -76,4 +80,8 @@ def main(folder):
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit(__doc__)
-    main(sys.argv[1])
+    try:
+        main(sys.argv[1])
+    except (OSError, ValueError, KeyError, TypeError) as e:  # a missing folder, a truncated or foreign sweep.json
+        print(f"plot_tradeoff.py: {sys.argv[1]}/sweep.json: {type(e).__name__}: {e}", file=sys.stderr)
+        sys.exit(2)
