@@ -391,6 +391,15 @@ TEST_CASE("the flag --threads limits a run's threads and its reports name the co
   CHECK(nlohmann::json::parse(report)["threads"].get<int>() == 1);
 }
 
+TEST_CASE("bench measures a structure named twice once", "[cli]") {
+  const Run r = run("bench --scene builtin:cornell --count 500 --repeat 1 --structures bvh,f-bvh,f-ls:3:3,bvh --json");
+  REQUIRE(r.status == 0);
+  const auto results = nlohmann::json::parse(r.out)["results"];
+  REQUIRE(results.size() == 3);  // bvh, f-ls:3:3, embree
+  CHECK(results[0]["structure"] == "bvh");
+  CHECK(results[1]["structure"] == "f-ls:3:3");
+}
+
 TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a name Embree does not know", "[cli]") {
   const Run r = run("bench --scene builtin:cornell --count 2000 --repeat 1 --structures bvh --embree-isa sse2");
   INFO(r.err);

@@ -21,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -329,7 +330,10 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   } else if (*c.render) {
     run_render(scene, v, *backend);
   } else if (*c.bench) {
-    const std::vector<StructureSpec> specs = parse_structure_list(v.structures);
+    // Each structure once, at its first place: "bvh,f-bvh" names one structure twice.
+    std::vector<StructureSpec> specs;
+    for (const StructureSpec& spec : parse_structure_list(v.structures))
+      if (std::find(specs.begin(), specs.end(), spec) == specs.end()) specs.push_back(spec);
     const std::vector<lsk::Ray> rays = v.rays_path.empty() ? make_rays(scene, v.bench_kind, v.count, v.seed) : read_rays(v.rays_path);
     if (rays.empty()) throw InputError("bench: the ray file holds no rays");
     const bool occlusion = v.bench_any_hit || (v.rays_path.empty() && v.bench_kind == "shadow");
