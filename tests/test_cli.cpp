@@ -391,6 +391,25 @@ TEST_CASE("the flag --threads limits a run's threads and its reports name the co
   CHECK(nlohmann::json::parse(report)["threads"].get<int>() == 1);
 }
 
+TEST_CASE("2l-ls:auto: a plan without a uniform reference has none in its JSON; a pilot that sees nothing says so", "[cli]") {
+  // Just above cornell's fixed part (0.2736 MB): no uniform 2l-ls:D:N fits, so there is none to name.
+  const Run r = run("build --scene builtin:cornell --structure 2l-ls:auto --ls-budget 0.274 --json");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const auto plan = nlohmann::json::parse(r.out)["ls_plan"];
+  CHECK(plan["reference"].is_null());  // it was "", with a uniform of 0 bytes
+  CHECK(plan["uniform"].is_null());
+  // A camera that looks away from the scene: the pilot's diffuse rays are the ones that fail.
+  write_text(temp("away.gltf"), ls_test::one_triangle_gltf(
+                                    R"("nodes":[{"mesh":0},{"camera":0,"translation":[0,0,-5]}],)"
+                                    R"("cameras":[{"type":"perspective","perspective":{"yfov":0.5,"znear":0.1}}],)"
+                                    R"("scenes":[{"nodes":[0,1]}])"));
+  const Run away = run("build --scene " + temp("away.gltf").string() + " --structure 2l-ls:auto --ls-budget 1");
+  INFO(away.err);
+  CHECK(away.status == 2);
+  CHECK(away.err.find("2l-ls:auto's pilot (diffuse rays from the camera's view") != std::string::npos);
+}
+
 TEST_CASE("bench measures a structure named twice once", "[cli]") {
   const Run r = run("bench --scene builtin:cornell --count 500 --repeat 1 --structures bvh,f-bvh,f-ls:3:3,bvh --json");
   REQUIRE(r.status == 0);

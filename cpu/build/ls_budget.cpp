@@ -193,7 +193,12 @@ Outcome run_on(const Accel& accel, const LsLookup& lookup, const PilotSet& set, 
 
 LsPilot ls_budget_pilot(const Scene& scene, const Accel& exact, size_t count) {
   LsPilot pilot;
-  pilot.rays = generate_rays(scene, exact, RayKind::Diffuse, std::max<size_t>(1, count), kPilotSeed);
+  try {
+    pilot.rays = generate_rays(scene, exact, RayKind::Diffuse, std::max<size_t>(1, count), kPilotSeed);
+  } catch (const InputError& e) {  // name the rays: the user asked for none
+    throw InputError(std::string("2l-ls:auto's pilot (diffuse rays from the camera's view, which measure each object's "
+                                 "error): ") + e.what());
+  }
   // Shadow rays as the path tracer casts them: from each exact hit, offset, to a point on a light
   // picked by power, both ends offset; none where the light lies behind the surface.
   const SurfaceLookup surfaces(scene);
