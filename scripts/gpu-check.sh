@@ -39,6 +39,8 @@ while (($#)); do
 done
 command -v python3 >/dev/null || fail "python3 is needed for the report (standard library only)"
 command -v timeout >/dev/null || fail "timeout (coreutils) is needed"
+# The bundle first: a run refused for want of one leaves no empty --out folder behind.
+[[ -d $bundle || -f $bundle ]] || fail "no bundle at $bundle (scripts/make-gpu-bundle.sh makes it)"
 mkdir -p "$out" || fail "cannot make $out"
 out=$(cd "$out" && pwd)
 work=$(mktemp -d "${TMPDIR:-/tmp}/gpu-check.XXXXXX") || fail "cannot make a temporary folder"
@@ -49,7 +51,7 @@ mkdir -p "$logs"
 if [[ -d $bundle ]]; then
   b=$(cd "$bundle" && pwd)
 elif [[ -f $bundle ]]; then
-  tar -C "$work" -xzf "$bundle" || fail "cannot unpack $bundle"
+  tar -C "$work" -xzf "$bundle" 2> "$work/tar.err" || fail "cannot unpack $bundle: $(grep -m 1 . "$work/tar.err")"
   b=$work/gpu-bundle
 else
   fail "no bundle at $bundle (scripts/make-gpu-bundle.sh makes it)"

@@ -206,7 +206,7 @@ def cmd_report(logs, out, mode, seconds, bundle):
     for s in steps:
         outp, errp = (read(os.path.join(logs, s["id"] + e)) for e in (".out", ".err"))
         s["status"] = status_of(s["rc"])
-        s["error"] = "" if s["rc"] == "0" else last_line(errp)
+        s["error"] = "" if s["rc"] in ("0", "-") else last_line(errp)  # a skipped step's status says why
         report["steps"].append(s)
         if s["kind"] == "devices":
             try:
