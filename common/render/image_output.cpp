@@ -49,13 +49,7 @@ void write_renamed(const std::string& path, WriteTemp&& write_temp) {
     std::filesystem::remove(temp, ec);
     throw std::runtime_error("cannot write '" + path + "': " + first_line(error));
   }
-  try {
-    replace_file(temp, path);
-  } catch (...) {
-    set_partial_file(nullptr);  // temp is gone, and its name with this frame
-    throw;
-  }
-  set_partial_file(nullptr);
+  replace_file(temp, path);
 }
 
 // A float EXR of `channels` interleaved per pixel, lossless zip compression.

@@ -140,13 +140,7 @@ void write_json_file(const std::string& path, const nlohmann::json& report, bool
       throw InputError("cannot write '" + path + "'");
     }
   }
-  try {
-    replace_file(temp, path);
-  } catch (...) {
-    set_partial_file(nullptr);  // temp is gone, and its name with this frame
-    throw;
-  }
-  set_partial_file(nullptr);
+  replace_file(temp, path);
 }
 
 }  // namespace ls
