@@ -138,11 +138,11 @@ std::vector<std::string> scene_list(const std::string& text) {
     const size_t comma = text.find(',', start);
     const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     if (item.empty()) throw InputError("--scenes '" + text + "': empty scene name");
-    if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);  // repeats: once
+    out.push_back(item);
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
-  return out;
+  return without_repeats(out);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 // data is written first (CSV, JSON); the plot is a separate step (plot_tradeoff.py).
 #pragma once
 
+#include "common/base/without_repeats.h"
 #include "common/structure/accel.h"
 #include "validate/measure.h"
 #include "validate/rmse_study.h"
@@ -12,7 +13,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -52,16 +52,8 @@ struct Sweep {
   nlohmann::json json() const;
 };
 
-// The lists of the studies' flags keep an item's first place and drop its repeats ("--depths 2,2"
-// rendered the same configuration twice), as --thresholds does.
-template <class T>
-std::vector<T> without_repeats(const std::vector<T>& items) {
-  std::vector<T> out;
-  for (const T& item : items)
-    if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
-  return out;
-}
-
+// The list flags below keep an item's first place and drop its repeats (without_repeats: "--depths
+// 2,2" rendered the same configuration twice), as --thresholds does.
 std::vector<int> parse_int_list(const std::string& text, const std::string& flag, int lo, int hi);
 std::vector<float> parse_angle_list(const std::string& text);
 std::vector<LsBehind> parse_behind_list(const std::string& text);

@@ -5,6 +5,7 @@
 #include "common/base/progress.h"
 #include "common/base/ray_files.h"
 #include "common/base/thread_limit.h"
+#include "common/base/without_repeats.h"
 #include "common/render/backend.h"
 #include "common/render/exposure.h"
 #include "common/render/render_output.h"
@@ -21,7 +22,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -330,10 +330,8 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   } else if (*c.render) {
     run_render(scene, v, *backend);
   } else if (*c.bench) {
-    // Each structure once, at its first place: "bvh,f-bvh" names one structure twice.
-    std::vector<StructureSpec> specs;
-    for (const StructureSpec& spec : parse_structure_list(v.structures))
-      if (std::find(specs.begin(), specs.end(), spec) == specs.end()) specs.push_back(spec);
+    // "bvh,f-bvh" names one structure twice: it is timed once.
+    const std::vector<StructureSpec> specs = without_repeats(parse_structure_list(v.structures));
     const std::vector<lsk::Ray> rays = v.rays_path.empty() ? make_rays(scene, v.bench_kind, v.count, v.seed) : read_rays(v.rays_path);
     if (rays.empty()) throw InputError("bench: the ray file holds no rays");
     const bool occlusion = v.bench_any_hit || (v.rays_path.empty() && v.bench_kind == "shadow");
