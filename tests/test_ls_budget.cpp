@@ -5,6 +5,7 @@
 #include "cpu/build/build_accel.h"
 #include "cpu/build/build_structures.h"
 #include "cpu/build/ls_budget.h"
+#include "cpu/build/structure_budget.h"
 #include "cpu/trace/ray_generators.h"
 #include "cpu/trace/trace_rays.h"
 #include "scenes/load_scene.h"
@@ -145,6 +146,27 @@ TEST_CASE("2l-ls:auto is refused without a budget, below its fixed part, and ove
   CHECK(parse_structure("2l-ls:auto").name() == "2l-ls:auto");
   CHECK(parse_structure("2L-LS:AUTO").budgeted);
   CHECK_THROWS_AS(parse_structure("f-ls:auto"), InputError);
+}
+
+TEST_CASE("2l-ls:auto's estimate is the menu's largest plan where the budget is larger", "[ls_budget]") {
+  // A budget far over what any plan can spend is no reason to refuse the structure: the estimate is
+  // the smaller of the budget and every object at the menu's largest D and N.
+  const Scene scene = load_scene(kScene);
+  const StructureSpec spec = parse_structure("2l-ls:auto");
+  AccelOptions huge = with_budget(1e6);  // 1 TB
+  AccelOptions largest;
+  largest.ls.objects.assign(scene.meshes.size(), ObjectLs{8, 10});
+  const StructureEstimate bound = estimate_structure_bytes(scene, parse_structure("2l-ls:8:10"), largest);
+  const StructureEstimate e = estimate_structure_bytes(scene, spec, huge);
+  CHECK(e.ls_bytes == bound.ls_bytes);
+  CHECK(e.ls_bytes < huge.plan.budget);
+  huge.limits.max_memory = 2 * bound.total();
+  CHECK_NOTHROW(check_structure_budget(scene, spec, huge));
+  huge.limits.max_memory = bound.total() - 1;
+  CHECK_THROWS_WITH(check_structure_budget(scene, spec, huge), Catch::Contains("lower --ls-budget"));
+  // A budget under the largest plan is itself the estimate.
+  const AccelOptions small = with_budget(double(bound.ls_bytes) / 2e6);
+  CHECK(estimate_structure_bytes(scene, spec, small).ls_bytes == small.plan.budget);
 }
 
 TEST_CASE("the pilot's lazily searched shafts answer like fully built Line Spaces", "[ls_budget]") {

@@ -302,13 +302,6 @@ PlanChoice optimise_plan(const std::vector<std::vector<PlanOption>>& options, si
   return out;
 }
 
-std::vector<ObjectLs> ls_budget_menu() {
-  std::vector<ObjectLs> menu;
-  for (int d : {0, 2, 4, 6, 8})
-    for (int n : {2, 4, 6, 8, 10}) menu.push_back(ObjectLs{d, n});
-  return menu;
-}
-
 LsPlan plan_line_space_budget(const Scene& scene, Accel& accel, const AccelOptions& accel_options) {
   const LsBuildOptions& options = accel_options.ls;
   const LsLookup& lookup = accel_options.plan.lookup;

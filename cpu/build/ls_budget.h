@@ -23,22 +23,20 @@
 // "None" is every object's free option, so objects that gain nothing (too few triangles, never
 // reached, slower with a Line Space) get none.  When the result would err more than the reference
 // in the pilot, the reference itself is the plan.  Finally both are evaluated jointly (every object's
-// Line Space at once) on the pilot, and reported.  The menu: D in {0, 2, 4, 6, 8} x N in {2, 4, 6, 8, 10}.
+// Line Space at once) on the pilot, and reported.  The menu (cpu/build/ls_budget_menu.h): D in {0, 2, 4, 6, 8} x N in {2, 4, 6, 8, 10}.
 #pragma once
 
 #include "common/kernels/layouts.h"
 #include "common/model/scene.h"
 #include "common/structure/accel.h"
 #include "cpu/build/line_space_builder.h"
+#include "cpu/build/ls_budget_menu.h"
 
 #include <cstddef>
 #include <string>
 #include <vector>
 
 namespace ls {
-
-// The menu of (D, N) an object can get.
-std::vector<ObjectLs> ls_budget_menu();
 
 // The pilot's pieces, for tests and studies that check the plan against full builds: `count` diffuse
 // rays (closest hit) and a shadow ray (any hit) from each one's exact hit to a light, as the path

@@ -2,6 +2,7 @@
 
 #include "common/base/memory_budget.h"
 #include "cpu/build/line_space_builder.h"
+#include "cpu/build/ls_budget_menu.h"
 
 #include <algorithm>
 #include <cmath>
@@ -31,13 +32,20 @@ StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSp
     size_t triangles;
     int depth, n;
   };
+  // 2l-ls:auto before its plan: every object at the menu's largest D and N bounds any plan.
+  const bool planned = spec.budgeted && ls.objects.empty();
+  const ObjectLs largest{*std::max_element(kLsBudgetDepths.begin(), kLsBudgetDepths.end()),
+                         *std::max_element(kLsBudgetSubdivisions.begin(), kLsBudgetSubdivisions.end())};
   std::vector<PerBvh> per_bvh;
   if (spec.two_level()) {
     std::vector<bool> used(scene.meshes.size(), false);
     for (const Instance& inst : scene.instances) used[inst.mesh] = true;
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
       if (!used[m]) continue;
-      const ObjectLs o = ls.objects.empty() ? ObjectLs{spec.depth, spec.subdivision} : m < ls.objects.size() ? ls.objects[m] : ObjectLs{};
+      const ObjectLs o = planned               ? largest
+                         : ls.objects.empty() ? ObjectLs{spec.depth, spec.subdivision}
+                         : m < ls.objects.size() ? ls.objects[m]
+                                                 : ObjectLs{};
       per_bvh.push_back({scene.meshes[m].triangles.size(), o.depth, o.n});
     }
   } else {
@@ -54,12 +62,10 @@ StructureEstimate estimate_structure_bytes(const Scene& scene, const StructureSp
     }
   }
   if (spec.two_level()) bvh += double(scene.instances.size()) * (sizeof(lsk::InstanceRecord) + 2 * sizeof(lsk::BvhNode) + 64);
-  // 2l-ls:auto spends at most its budget on the Line Space (the plan's bytes are exact), and its
-  // pilot holds one object's Line Space at a time, no more than the budget either.
-  const bool planned = spec.budgeted && ls.objects.empty();
-  const double ls_bytes = !spec.line_space() ? 0.0
-                          : planned         ? double(options.plan.budget)
-                                            : shafts * 4.0 + nodes * sizeof(lsk::LsNode) + triangles * kLsBytesPerTriangle;
+  // 2l-ls:auto spends at most its budget on the Line Space (the plan's bytes are exact), and no more
+  // than the largest plan of its menu; its pilot holds one object's Line Space at a time, no more.
+  const double largest_ls = shafts * 4.0 + nodes * sizeof(lsk::LsNode) + triangles * kLsBytesPerTriangle;
+  const double ls_bytes = !spec.line_space() ? 0.0 : planned ? std::min(double(options.plan.budget), largest_ls) : largest_ls;
   // Saturate instead of overflowing size_t (2^60 nodes of 2 GB each are representable in double).
   const double cap = double(SIZE_MAX / 4);
   StructureEstimate e;
