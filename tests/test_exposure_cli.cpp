@@ -123,7 +123,7 @@ TEST_CASE("render --exposure EV scales the PNG by 2^EV against the EXR, and auto
   fs::remove_all(temp(""));
   const std::string args = "render --scene builtin:cornell --size 40x30 --spp 2 --bounces 2 --quiet --out ";
   for (const char* name : {"auto", "minus2", "plus1"}) {
-    const std::string ev = std::string(name) == "auto" ? "auto" : std::string(name) == "minus2" ? "-2" : "1";
+    const std::string ev = std::string(name) == "auto" ? "auto" : std::string(name) == "minus2" ? "-2" : "+1";
     const Run r = run(args + temp(name).string() + " --exposure " + ev);
     INFO(r.err);
     REQUIRE(r.status == 0);
@@ -162,7 +162,7 @@ TEST_CASE("render --exposure EV scales the PNG by 2^EV against the EXR, and auto
 
 TEST_CASE("render --exposure refuses what is not auto or a number of stops, with exit 2 and a one-line reason", "[exposure_cli]") {
   fs::remove_all(temp(""));
-  for (const char* bad : {"abc", "nan", "inf", "-inf", "1e9", "65", "2x", "''"}) {
+  for (const char* bad : {"abc", "nan", "inf", "-inf", "1e9", "65", "2x", "''", "0x10", "' 1'", "1e", "++1", "+-1"}) {
     const Run r = run("render --scene builtin:cornell --size 8x8 --spp 1 --quiet --exposure " + std::string(bad) + " --out " +
                       temp("bad").string());
     INFO(bad << ": " << r.err);

@@ -112,9 +112,9 @@ TEST_CASE("tile ranges (--tiles A:B) and shards (--shard K/N) select what they s
   for (int k = 0; k < 7; ++k)
     for (uint32_t t : parse_shard(std::to_string(k) + "/7", grid)) ++seen[t];
   for (int n : seen) REQUIRE(n == 1);
-  for (const char* bad : {"3:3", "4:2", "0:16", "a:b", "-1:2", "1:", ":2", "1:2:3", "", "1 :2", "0x1:2"})
+  for (const char* bad : {"3:3", "4:2", "0:16", "a:b", "-1:2", "1:", ":2", "1:2:3", "", "1 :2", "0x1:2", "01:2", "0:02"})
     REQUIRE_THROWS_AS(parse_tile_range(bad, grid), InputError);
-  for (const char* bad : {"3/3", "4/3", "0/0", "1/x", "15/16", "", "1/", "/2", "-1/2", "1/2/3"})
+  for (const char* bad : {"3/3", "4/3", "0/0", "1/x", "15/16", "", "1/", "/2", "-1/2", "1/2/3", "01/3", "1/03", "00/3"})
     REQUIRE_THROWS_AS(parse_shard(bad, grid), InputError);
   REQUIRE_THROWS_AS(choose_tiles("0:2", "0/2", 8, 37, 23), InputError);
   REQUIRE_FALSE(choose_tiles("", "", 8, 37, 23).sharded());

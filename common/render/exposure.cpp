@@ -4,21 +4,20 @@
 #include "common/kernels/sampling.h"
 
 #include <algorithm>
-#include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 namespace ls {
 
 ExposureRequest parse_exposure(const std::string& text) {
   if (text == "auto") return {};
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double ev = std::strtod(begin, &end);
-  if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(ev) ||
-      std::abs(ev) > double(kMaxExposureEv))
+  // Decimal only, as every other number flag reads it (strtod took "0x10" and " 1"); "+1" is an EV.
+  const char* begin = text.data() + (text.size() > 1 && text[0] == '+' && text[1] != '-');
+  const char* end = text.data() + text.size();
+  double ev = 0.0;
+  const auto r = std::from_chars(begin, end, ev);
+  if (text.empty() || r.ec != std::errc() || r.ptr != end || !std::isfinite(ev) || std::abs(ev) > double(kMaxExposureEv))
     throw InputError("--exposure '" + text + "': expected auto or a number of stops (EV) from -64 to 64");
   return ExposureRequest{false, float(ev)};
 }
