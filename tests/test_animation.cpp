@@ -197,7 +197,7 @@ TEST_CASE("glTF animation: a scene without animations keeps its transforms bit f
   CHECK(s.rig.animations.empty());
 }
 
-TEST_CASE("glTF animation: several animations, the one asked for is posed; a missing one is refused", "[animation]") {
+TEST_CASE("glTF animation: several animations, the one asked for is posed, and a missing one is refused", "[animation]") {
   const std::string json = file_with(R"([{"mesh":0}])", [](Gltf& g) {
     const int in = g.scalars({0.0f, 1.0f});
     const int a = g.vec3({{0, 0, 0}, {2, 0, 0}}), b = g.vec3({{0, 0, 0}, {0, 4, 0}});

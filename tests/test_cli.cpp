@@ -391,7 +391,7 @@ TEST_CASE("the flag --threads limits a run's threads and its reports name the co
   CHECK(nlohmann::json::parse(report)["threads"].get<int>() == 1);
 }
 
-TEST_CASE("2l-ls:auto: a plan without a uniform reference has none in its JSON; a pilot that sees nothing says so", "[cli]") {
+TEST_CASE("2l-ls:auto: a plan without a uniform reference has none in its JSON, and a pilot that sees nothing says so", "[cli]") {
   // Just above cornell's fixed part (0.2736 MB): no uniform 2l-ls:D:N fits, so there is none to name.
   const Run r = run("build --scene builtin:cornell --structure 2l-ls:auto --ls-budget 0.274 --json");
   INFO(r.err);
@@ -430,7 +430,7 @@ TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a nam
   CHECK(bad.out.empty());
 }
 
-TEST_CASE("bench and linespace-profile --embree refuse rays Embree cannot take; bench warns where Embree answers otherwise",
+TEST_CASE("bench and linespace-profile --embree refuse rays Embree cannot take, and bench warns where Embree answers otherwise",
           "[cli]") {
   // Embree 3 aborts on a ray with tmin < 0 or a component past 1.844e18 (its assertions).
   const std::array<std::pair<const char*, lsk::Ray>, 3> outside = {{

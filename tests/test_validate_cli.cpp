@@ -94,7 +94,7 @@ TEST_CASE("linespace-validate: bad --spp, --auto-rel-stderr and --auto-seconds e
   REQUIRE_FALSE(fs::exists(temp("unused") / "rmse.json"));
 }
 
-TEST_CASE("linespace-validate rmse.json rows carry rmse_bias and its standard error; --spp auto says why it stopped", "[cli]") {
+TEST_CASE("linespace-validate rmse.json rows carry rmse_bias and its standard error, and --spp auto says why it stopped", "[cli]") {
   const fs::path out = temp("rmse_bias");
   const std::string common = " --scene builtin:cornell --structures f-ls:3:4 --size 16x16 --bounces 2 --ls-min-triangles 0 --out ";
   // 8 spp: at 4 the second row's errors fell in one half per pixel only (rmse_bias undetermined, null).
