@@ -1,5 +1,5 @@
 // linespace-validate end to end: bad input exits 2 with one line, and each study writes the files and
-// keys docs/design.md §9 promises, with figures that must hold by construction.
+// keys docs/usage.md promises, with figures that must hold by construction.
 #include "tests/test_helpers.h"
 
 #include <catch2/catch.hpp>
@@ -358,4 +358,47 @@ TEST_CASE("linespace-validate policy writes policy.{md,csv,json} with both polic
   REQUIRE(j["comparisons"][0]["start_bounce"] == 2);
   REQUIRE(fs::file_size(out / "policy.md") > 0);
   REQUIRE(fs::file_size(out / "policy.csv") > 0);
+}
+
+TEST_CASE("linespace-validate budget compares each uniform 2L-LS with a 2l-ls:auto of its bytes", "[cli]") {
+  const fs::path out = temp("budget");
+  const Run r = validate("budget --scene builtin:cornell --uniform 2l-ls:2:4,2l-ls:0:6 --size 16x16 --spp 4 --bounces 2 --out " +
+                         out.string());
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "budget.json"));
+  REQUIRE(j["rows"].size() == 2);
+  REQUIRE(j["rows"][0]["uniform_structure"] == "2l-ls:2:4");
+  REQUIRE(j["rows"][1]["uniform_structure"] == "2l-ls:0:6");
+  for (const auto& row : j["rows"]) {
+    INFO(row["uniform_structure"]);
+    const auto &uniform = row["uniform"], &planned = row["auto"], &plan = planned["plan"];
+    // The budget is the uniform structure's Line Space, and the plan spends no more, exactly as predicted.
+    CHECK(row["budget_bytes"] == uniform["bytes_ls"]);
+    CHECK(plan["budget_bytes"] == row["budget_bytes"]);
+    CHECK(planned["bytes_ls"].get<size_t>() <= row["budget_bytes"].get<size_t>());
+    CHECK(planned["bytes_ls"] == planned["predicted_bytes"]);
+    size_t objects = plan["fixed_bytes"].get<size_t>();
+    for (const auto& o : plan["objects"]) objects += o["bytes"].get<size_t>();
+    CHECK(objects == plan["predicted_bytes"].get<size_t>());
+    CHECK(plan["objects"].size() == 10);  // cornell's objects
+    for (const char* key : {"rmse_from_bounce", "rmse_bias_from_bounce", "rmse_bias_stderr_from_bounce", "noise_floor_from_bounce",
+                            "spp_from_bounce"}) {
+      REQUIRE(uniform[key].size() == 2);
+      REQUIRE(planned[key].size() == 2);
+    }
+    // A plan that is the uniform structure itself renders its images.
+    if (plan["reference_chosen"].get<bool>()) CHECK(planned["rmse_from_bounce"] == uniform["rmse_from_bounce"]);
+    // The verdict follows its rule: rmse_bias where both are estimated, else the RMSE, lower at every start bounce.
+    bool lower = true;
+    for (size_t k = 0; k < 2; ++k) {
+      const bool estimated = !planned["rmse_bias_from_bounce"][k].is_null() && !uniform["rmse_bias_from_bounce"][k].is_null();
+      const char* figure = estimated ? "rmse_bias_from_bounce" : "rmse_from_bounce";
+      lower = lower && planned[figure][k].get<double>() < uniform[figure][k].get<double>();
+    }
+    CHECK(row["lower_rmse_at_every_start_bounce"] == lower);
+  }
+  CHECK(fs::file_size(out / "budget.md") > 0);
+  std::ifstream csv(out / "budget.csv");
+  CHECK(std::count(std::istreambuf_iterator<char>(csv), std::istreambuf_iterator<char>(), '\n') == 1 + 2 * 2);
 }

@@ -50,8 +50,9 @@ void check_fast_path_budget(const Accel& accel, int exact_width, size_t max_memo
   const size_t fast = fast_path_bytes_at_most(accel, exact_width);
   if (built <= budget && fast <= budget - built) return;
   throw InputError("the fast path of structure '" + accel.spec.name() + "' (its wide trees and triangle blocks) would take up to " +
-                   mib_text(double(fast)) + " beside the structure's " + mib_text(double(built)) + ", over the budget of " +
-                   mib_budget_text(double(budget)) + ": use a smaller scene, --exact-width 4, or raise --max-memory");
+                   mib_text(double(fast)) + " beside the structure's " + mib_text(double(built)) + ", together " +
+                   mib_text(double(fast) + double(built)) + ", over the budget of " + mib_budget_text(double(budget)) +
+                   ": use a smaller scene, --exact-width 4, or raise --max-memory");
 }
 
 }  // namespace ls
