@@ -430,6 +430,43 @@ TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a nam
   CHECK(bad.out.empty());
 }
 
+TEST_CASE("a ray with a subnormal direction component is refused, not missed", "[cli]") {
+  // One triangle at scale 1 and the line x = 1, z = 1 - s, y = -0.01 + 0.05 s, which crosses it at s = 1.
+  // Scaled by 2^-126 the direction's y is subnormal; the box test took it as 0, a ray parallel to the
+  // y slab outside it, and missed with exit 0.  At 2^-100 every component is normal and it hits.
+  const fs::path obj = temp("subnormal_dir.obj"), rays = temp("subnormal_dir.rays"), hits = temp("subnormal_dir.hits");
+  fs::create_directories(obj.parent_path());
+  write_text(obj, "v 0 0 0\nv 4 0 0\nv 0 4 0\nf 1 2 3\n");
+  auto ray = [](int exponent) {
+    return lsk::Ray{glm::vec3(1.0f, -0.01f, 1.0f), 0.0f, glm::vec3(0.0f, std::ldexp(0.05f, exponent), std::ldexp(-1.0f, exponent)),
+                    std::numeric_limits<float>::infinity()};
+  };
+  ls::write_rays(rays.string(), {ray(-100)});
+  REQUIRE(run("trace --scene " + obj.string() + " --structure bvh --rays " + rays.string() + " --hits " + hits.string()).status == 0);
+  const std::vector<lsk::Hit> hit = ls::read_hits(hits.string());
+  REQUIRE(hit.size() == 1);
+  CHECK(hit[0].triangle == 0);
+  CHECK(hit[0].t == std::ldexp(1.0f, 100));
+  // The subnormal one, written as raw bytes (write_rays refuses it and writes nothing).
+  const lsk::Ray subnormal = ray(-126);
+  REQUIRE(std::fpclassify(subnormal.dir.y) == FP_SUBNORMAL);
+  fs::remove(rays);
+  CHECK_THROWS_WITH(ls::write_rays(rays.string(), {subnormal}), Catch::Contains("subnormal"));
+  CHECK(!fs::exists(rays));
+  {
+    std::ofstream out(rays, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(&subnormal), sizeof subnormal);
+  }
+  for (const char* structure : {"bvh", "f-ls:0:2"}) {
+    const Run r = run("trace --scene " + obj.string() + " --structure " + structure + " --rays " + rays.string() + " --hits " +
+                      hits.string());
+    INFO(r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find("ray 0: direction component y") != std::string::npos);
+  }
+}
+
 TEST_CASE("bench and linespace-profile --embree refuse rays Embree cannot take, and bench warns where Embree answers otherwise",
           "[cli]") {
   // Embree 3 aborts on a ray with tmin < 0 or a component past 1.844e18 (its assertions).
