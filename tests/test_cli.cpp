@@ -430,6 +430,24 @@ TEST_CASE("bench --embree-isa limits Embree's instruction set, and refuses a nam
   CHECK(bad.out.empty());
 }
 
+TEST_CASE("trace refuses a hit file that is its ray file or its --against file, and leaves it as it was", "[cli]") {
+  fs::create_directories(temp(""));
+  const fs::path rays = temp("self.rays"), hits = temp("self.hits");
+  REQUIRE(run("rays --count 10 --out " + rays.string()).status == 0);
+  REQUIRE(run("trace --rays " + rays.string() + " --hits " + hits.string()).status == 0);
+  const std::string ray_bytes = slurp(rays), hit_bytes = slurp(hits);
+  for (const auto& [args, file, bytes] :
+       {std::tuple{"--hits " + rays.string(), rays, ray_bytes}, std::tuple{"--hits " + hits.string() + " --against " + hits.string(), hits, hit_bytes},
+        std::tuple{"--hits " + (rays.parent_path() / "." / rays.filename()).string(), rays, ray_bytes}}) {
+    const Run r = run("trace --rays " + rays.string() + " " + args);
+    INFO(args << ": " << r.err);
+    CHECK(r.status == 2);
+    CHECK(line_count(r.err) == 1);
+    CHECK(r.err.find("is the input file") != std::string::npos);
+    CHECK(slurp(file) == bytes);
+  }
+}
+
 TEST_CASE("a ray with a subnormal direction component is refused, not missed", "[cli]") {
   // One triangle at scale 1 and the line x = 1, z = 1 - s, y = -0.01 + 0.05 s, which crosses it at s = 1.
   // Scaled by 2^-126 the direction's y is subnormal; the box test took it as 0, a ray parallel to the

@@ -24,8 +24,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <limits>
+#include <system_error>
 
 namespace ls {
 namespace {
@@ -311,6 +313,10 @@ void run(const Commands& c, const Values& v, const ProgramInfo& info) {
   } else if (*c.trace) {
     // The files first: bad input is refused before a structure is built.
     const std::vector<lsk::Ray> in = read_rays(v.rays_path);
+    std::error_code same_error;
+    for (const std::string& input : {v.rays_path, v.against_path})
+      if (!input.empty() && std::filesystem::equivalent(input, v.hits_path, same_error))
+        throw InputError("--hits " + v.hits_path + " is the input file " + input + ": writing it would replace what is read");
     const std::vector<lsk::Hit> against = v.against_path.empty() ? std::vector<lsk::Hit>{} : read_hits(v.against_path);
     if (!v.against_path.empty() && against.size() != in.size())
       throw InputError("--against " + v.against_path + " holds " + std::to_string(against.size()) + " hits for " +
