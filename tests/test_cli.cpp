@@ -437,7 +437,8 @@ TEST_CASE("trace refuses a hit file that is its ray file or its --against file, 
   REQUIRE(run("trace --rays " + rays.string() + " --hits " + hits.string()).status == 0);
   const std::string ray_bytes = slurp(rays), hit_bytes = slurp(hits);
   for (const auto& [args, file, bytes] :
-       {std::tuple{"--hits " + rays.string(), rays, ray_bytes}, std::tuple{"--hits " + hits.string() + " --against " + hits.string(), hits, hit_bytes},
+       {std::tuple{"--hits " + rays.string(), rays, ray_bytes},
+        std::tuple{"--hits " + hits.string() + " --against " + hits.string(), hits, hit_bytes},
         std::tuple{"--hits " + (rays.parent_path() / "." / rays.filename()).string(), rays, ray_bytes}}) {
     const Run r = run("trace --rays " + rays.string() + " " + args);
     INFO(args << ": " << r.err);

@@ -42,7 +42,8 @@ TileSet all_tiles(const TileGrid& grid) {
 TileSet parse_tile_range(const std::string& text, const TileGrid& grid) {
   uint64_t a = 0, b = 0;
   const std::string flag = "--tiles " + text;
-  if (!parse_pair(text, ':', a, b)) throw InputError(flag + ": expected A:B, the tiles A to B-1, in decimal without leading zeros (e.g. 0:16)");
+  if (!parse_pair(text, ':', a, b))
+    throw InputError(flag + ": expected A:B, the tiles A to B-1, in decimal without leading zeros (e.g. 0:16)");
   if (a >= b) throw InputError(flag + ": A must be less than B (the range A:B holds the tiles A to B-1)");
   if (b > grid.count())
     throw InputError(flag + ": past the last tile; the image has " + grid.describe() + ", so B <= " +
@@ -55,7 +56,8 @@ TileSet parse_tile_range(const std::string& text, const TileGrid& grid) {
 TileSet parse_shard(const std::string& text, const TileGrid& grid) {
   uint64_t k = 0, n = 0;
   const std::string flag = "--shard " + text;
-  if (!parse_pair(text, '/', k, n)) throw InputError(flag + ": expected K/N, shard K of N counted from 0, in decimal without leading zeros (e.g. 0/8)");
+  if (!parse_pair(text, '/', k, n))
+    throw InputError(flag + ": expected K/N, shard K of N counted from 0, in decimal without leading zeros (e.g. 0/8)");
   if (n == 0) throw InputError(flag + ": N must be at least 1");
   if (k >= n) throw InputError(flag + ": K must be less than N (shards are numbered 0 to N-1)");
   if (k >= grid.count())
