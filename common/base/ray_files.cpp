@@ -1,11 +1,11 @@
 #include "common/base/ray_files.h"
 
+#include "common/base/float_text.h"
 #include "common/base/interrupt.h"
 #include "common/base/replace_file.h"
 #include "common/model/scene.h"
 
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -46,12 +46,6 @@ void write_records(const std::string& path, const std::vector<T>& records, const
   replace_file(temp, path);
 }
 
-std::string shortest(float v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", double(v));
-  return text;
-}
-
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // What read_rays refuses in a ray, as "<where>why"; `where` names the file or the program and the ray.
@@ -63,7 +57,7 @@ void check_ray(const lsk::Ray& r, const std::string& where) {
   // distance of a face: refused rather than answered wrong.
   for (int a = 0; a < 3; ++a)
     if (r.dir[a] != 0.0f && std::fpclassify(r.dir[a]) == FP_SUBNORMAL)
-      throw InputError(where + "direction component " + "xyz"[a] + " = " + shortest(r.dir[a]) +
+      throw InputError(where + "direction component " + "xyz"[a] + " = " + float_text(r.dir[a]) +
                        " is subnormal (below 1.18e-38 in magnitude), which the box test takes as 0: set it to 0, "
                        "or scale the whole direction up (t scales down with it)");
   if (std::isnan(r.tmin) || std::isnan(r.tmax) || r.tmin > r.tmax) throw InputError(where + "NaN bounds or tmin > tmax");

@@ -1,11 +1,11 @@
 #include "common/render/render_partial.h"
 
+#include "common/base/float_text.h"
 #include "common/render/image_output.h"
 #include "common/render/render_types.h"
 #include "common/structure/accel.h"
 
 #include <algorithm>
-#include <cstdio>
 
 namespace ls {
 namespace {
@@ -20,12 +20,6 @@ std::vector<std::string> channel_names(int bounces) {
   add("total");
   for (int k = 0; k <= bounces; ++k) add("bounce_" + std::to_string(k));
   return names;
-}
-
-std::string float_text(float v) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.9g", double(v));
-  return text;
 }
 
 }  // namespace

@@ -23,8 +23,7 @@
 // "None" is every object's free option, so objects that gain nothing (too few triangles, never
 // reached, slower with a Line Space) get none.  When the result would err more than the reference
 // in the pilot, the reference itself is the plan.  Finally both are evaluated jointly (every object's
-// Line Space at once) on the pilot, and reported.  The menu (cpu/build/ls_budget_menu.h): D in
-// {0, 2, 4, 6, 8} x N in {2, 4, 6, 8, 10}.
+// Line Space at once) on the pilot, and reported.  The menu of (D, N): cpu/build/ls_budget_menu.h.
 #pragma once
 
 #include "common/kernels/layouts.h"
